@@ -1,0 +1,1 @@
+//! Link-only crate: see `build.rs`. It exports nothing.

@@ -1,0 +1,34 @@
+// Structs that cross to the GPU. Mirrored one-to-one by `src/gpu_types.rs` (#[repr(C)], std140
+// and std430 compatible: only vec4 and mat4 members); keep the two in step.
+#ifndef SOFTSHADOW_INTERFACE_GLSL
+#define SOFTSHADOW_INTERFACE_GLSL
+
+// Per-frame camera and light, shared by every pass.
+struct FrameGlobals {
+    mat4 view_proj;       // world -> camera clip (reverse Z: near 1, far 0)
+    mat4 inv_view_proj;   // camera clip -> world
+    vec4 camera_position; // xyz; w = 1 perspective, 0 orthographic
+    vec4 camera_forward;  // xyz; w unused
+    vec4 light;           // xyz centre, w radius (0 = point light)
+    vec4 light_color;     // rgb radiance scale; a unused
+    vec4 ambient;         // rgb; a unused
+    vec4 sky;             // rgb background; a unused
+    vec4 viewport;        // width, height, 1/width, 1/height
+};
+
+// One per drawn object, indexed by gl_InstanceIndex (the draw's firstInstance).
+struct ObjectData {
+    mat4 model;          // object -> world
+    mat4 normal_matrix;  // inverse transpose of the model's 3x3, in the upper left
+    vec4 albedo;         // rgb linear albedo; a = 1 if the object receives shadows, else 0
+};
+
+// A perspective view from the light (the spot frustum of DESIGN.md's shadow map).
+struct LightView {
+    mat4 view;       // world -> light view: +Z looks away from the light, linear depth = z
+    mat4 view_proj;  // world -> light clip
+    vec4 extent;     // tangent-space window: x0, y0, x1, y1 (x/z and y/z of the frustum's sides)
+    vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
+};
+
+#endif

@@ -1,0 +1,19 @@
+#version 460
+#include "interface.glsl"
+
+layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
+layout(set = 0, binding = 1) readonly buffer Objects { ObjectData objects[]; };
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+
+layout(location = 0) out vec3 out_normal;
+layout(location = 1) flat out vec4 out_albedo;
+
+void main() {
+    ObjectData object = objects[gl_InstanceIndex];
+    vec4 world = object.model * vec4(in_position, 1.0);
+    out_normal = mat3(object.normal_matrix) * in_normal;
+    out_albedo = object.albedo;
+    gl_Position = frame.view_proj * world;
+}

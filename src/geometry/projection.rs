@@ -1,0 +1,128 @@
+//! Camera matrices following DESIGN.md §3: forward = normalize(target − position),
+//! right = normalize(forward × up), up' = right × forward; image x grows with right, rows grow
+//! with −up' (row 0 at the top). Depth is reversed (near 1, far 0) for float precision, and the
+//! near and far planes are fitted to the scene's bounds every frame, never hard-coded.
+
+use glam::{DMat4, DVec4, Mat4, Vec3};
+
+use super::{Aabb, Hexahedron};
+
+/// How the camera projects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Vertical field of view in degrees, in (0, 180).
+    Perspective { fov_y_deg: f32 },
+    /// Half the view's height in world units; half width = half height × aspect.
+    Orthographic { half_height: f32 },
+}
+
+/// A camera's matrices for one frame.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraProjection {
+    pub view_proj: Mat4,
+    pub inv_view_proj: Mat4,
+    pub forward: Vec3,
+    /// The view volume between the fitted near and far planes.
+    pub frustum: Hexahedron,
+}
+
+/// Reverse-Z perspective from view space (x right, y up, z forward) to Vulkan clip space.
+fn reverse_z_perspective(tan_half_fov_y: f64, aspect: f64, near: f64, far: f64) -> DMat4 {
+    let (a, b) = (-near / (far - near), near * far / (far - near));
+    DMat4::from_cols(
+        DVec4::new(1.0 / (tan_half_fov_y * aspect), 0.0, 0.0, 0.0),
+        DVec4::new(0.0, -1.0 / tan_half_fov_y, 0.0, 0.0),
+        DVec4::new(0.0, 0.0, a, 1.0),
+        DVec4::new(0.0, 0.0, b, 0.0),
+    )
+}
+
+impl CameraProjection {
+    /// `up` must not be parallel to `target − position` (the scene loader checks).
+    pub fn new(position: Vec3, target: Vec3, up: Vec3, projection: Projection, aspect: f32, scene: &Aabb) -> Self {
+        let (pos, forward) = (position.as_dvec3(), (target - position).as_dvec3().normalize());
+        let right = forward.cross(up.as_dvec3()).normalize();
+        let true_up = right.cross(forward);
+        let view = DMat4::from_cols(
+            DVec4::new(right.x, true_up.x, forward.x, 0.0),
+            DVec4::new(right.y, true_up.y, forward.y, 0.0),
+            DVec4::new(right.z, true_up.z, forward.z, 0.0),
+            DVec4::new(-right.dot(pos), -true_up.dot(pos), -forward.dot(pos), 1.0),
+        );
+        let depths = scene.corners().map(|c| forward.dot(c.as_dvec3() - pos));
+        let (dmin, dmax) = depths.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
+        let aspect = aspect as f64;
+        let proj = match projection {
+            Projection::Perspective { fov_y_deg } => {
+                let far = if dmax > 0.0 { dmax * 1.01 } else { 1.0 };
+                // Reverse Z keeps precision with a near plane this close.
+                let near = (dmin * 0.99).max(far * 1e-5);
+                reverse_z_perspective(((fov_y_deg as f64).to_radians() * 0.5).tan(), aspect, near, far)
+            }
+            Projection::Orthographic { half_height } => {
+                let pad = ((dmax - dmin) * 0.01).max(1e-6 * dmax.abs().max(1.0));
+                let (near, far) = (dmin - pad, dmax + pad);
+                let h = half_height as f64;
+                DMat4::from_cols(
+                    DVec4::new(1.0 / (h * aspect), 0.0, 0.0, 0.0),
+                    DVec4::new(0.0, -1.0 / h, 0.0, 0.0),
+                    DVec4::new(0.0, 0.0, -1.0 / (far - near), 0.0),
+                    DVec4::new(0.0, 0.0, far / (far - near), 1.0),
+                )
+            }
+        };
+        let view_proj = proj * view;
+        // Inverted in double precision: positions rebuilt from depth stay exact at large scales.
+        let inv = view_proj.inverse();
+        let corners = std::array::from_fn(|i| {
+            let ndc = DVec4::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { 1.0 } else { 0.0 },
+                1.0,
+            );
+            let w = inv * ndc;
+            (w.truncate() / w.w).as_vec3()
+        });
+        CameraProjection {
+            view_proj: view_proj.as_mat4(),
+            inv_view_proj: inv.as_mat4(),
+            forward: forward.as_vec3(),
+            frustum: Hexahedron { corners },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene() -> Aabb {
+        Aabb { min: Vec3::splat(-1.0), max: Vec3::splat(1.0) }
+    }
+
+    fn ndc(m: &Mat4, p: Vec3) -> Vec3 {
+        m.project_point3(p)
+    }
+
+    #[test]
+    fn right_is_plus_x_and_up_is_minus_y_in_ndc() {
+        for projection in [Projection::Perspective { fov_y_deg: 45.0 }, Projection::Orthographic { half_height: 2.0 }] {
+            let cam = CameraProjection::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene());
+            // Looking down −Z with +Y up, world +X is to the right and +Y is the top row.
+            assert!(ndc(&cam.view_proj, Vec3::X * 0.5).x > 0.0);
+            assert!(ndc(&cam.view_proj, Vec3::Y * 0.5).y < 0.0);
+        }
+    }
+
+    #[test]
+    fn reverse_z_covers_the_scene() {
+        let cam = CameraProjection::new(Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene());
+        let near = ndc(&cam.view_proj, Vec3::splat(1.0)).z;
+        let far = ndc(&cam.view_proj, Vec3::splat(-1.0)).z;
+        assert!(near > far && (0.0..=1.0).contains(&near) && (0.0..=1.0).contains(&far));
+        let p = Vec3::new(0.3, -0.2, 0.1);
+        let back = cam.inv_view_proj.project_point3(ndc(&cam.view_proj, p));
+        assert!((back - p).length() < 1e-4);
+    }
+}

@@ -1,0 +1,102 @@
+//! Synchronization2 barriers with explicit stage/access/layout triples (niagara's
+//! `imageBarrier`). A target remembers its last [`Access`]; a transition names the next one and
+//! whether the old contents may be discarded.
+
+use ash::vk;
+
+use super::Context;
+use super::target::{Target, subresource};
+
+/// How a pass touches an image: in which stage, with which access, in which layout.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Access {
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+    pub layout: vk::ImageLayout,
+}
+
+impl Access {
+    /// Not touched yet.
+    pub const NONE: Access =
+        Access { stage: vk::PipelineStageFlags2::NONE, access: vk::AccessFlags2::NONE, layout: vk::ImageLayout::UNDEFINED };
+    /// Written as a color attachment.
+    pub const COLOR_WRITE: Access = Access {
+        stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+        access: vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+        layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+    };
+    /// Tested and written as a depth attachment.
+    pub const DEPTH_WRITE: Access = Access {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+        ),
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw() | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+        ),
+        layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+    };
+    /// Sampled by fragment shaders (color).
+    pub const FRAGMENT_READ: Access = Access {
+        stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        access: vk::AccessFlags2::SHADER_SAMPLED_READ,
+        layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+    };
+    /// Sampled by fragment shaders (depth).
+    pub const DEPTH_FRAGMENT_READ: Access = Access {
+        stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
+        access: vk::AccessFlags2::SHADER_SAMPLED_READ,
+        layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
+    };
+    /// Copied out for readback.
+    pub const COPY_READ: Access = Access {
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_READ,
+        layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+    };
+}
+
+/// Transitions `target` from its last access to `next`. With `discard`, the old contents are
+/// not needed (layout UNDEFINED): only the earlier accesses must finish first.
+pub fn transition(ctx: &Context, cmd: vk::CommandBuffer, targets: &mut [(&mut Target, Access, bool)]) {
+    let barriers: Vec<_> = targets
+        .iter_mut()
+        .filter(|(t, next, discard)| *discard || t.last != *next || is_write(t.last.access))
+        .map(|(t, next, discard)| {
+            let last = t.last;
+            t.last = *next;
+            vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(last.stage)
+                // Only writes need making available; reads need just the execution dependency.
+                .src_access_mask(if is_write(last.access) { last.access } else { vk::AccessFlags2::NONE })
+                .dst_stage_mask(next.stage)
+                .dst_access_mask(next.access)
+                .old_layout(if *discard { vk::ImageLayout::UNDEFINED } else { last.layout })
+                .new_layout(next.layout)
+                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                .image(t.image)
+                .subresource_range(subresource(t.desc.aspect()))
+        })
+        .collect();
+    if !barriers.is_empty() {
+        let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+    }
+}
+
+/// Makes transfer writes to a readback buffer visible to the host after the frame's fence.
+pub fn copy_to_host(ctx: &Context, cmd: vk::CommandBuffer) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::COPY)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+        .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+    let dep = vk::DependencyInfo::default().memory_barriers(&barrier);
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
+}
+
+fn is_write(access: vk::AccessFlags2) -> bool {
+    access.intersects(
+        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags2::TRANSFER_WRITE,
+    )
+}

@@ -1,0 +1,122 @@
+//! Frames in flight: a command buffer, a fence and a pass timer each. Beginning a frame waits
+//! for the one that last used its slot and hands back that frame's pass times.
+
+use ash::vk;
+
+use super::Context;
+use super::timestamps::{PassTime, PassTimer};
+use crate::error::{Result, VkContext};
+
+/// Frames the CPU may record ahead of the GPU.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+struct Slot {
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    timer: PassTimer,
+}
+
+/// The ring of frame slots.
+pub struct FrameRing {
+    pool: vk::CommandPool,
+    slots: Vec<Slot>,
+    next: usize,
+}
+
+/// A frame being recorded.
+pub struct Frame<'a> {
+    /// Index of the slot: selects per-frame buffers.
+    pub slot: usize,
+    pub cmd: vk::CommandBuffer,
+    pub timer: &'a mut PassTimer,
+}
+
+impl FrameRing {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let pool_ci = vk::CommandPoolCreateInfo::default()
+            .queue_family_index(ctx.queue_family)
+            .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+        let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
+        let mut ring = FrameRing { pool, slots: Vec::new(), next: 0 };
+        if let Err(e) = ring.fill(ctx) {
+            ring.destroy(ctx);
+            return Err(e);
+        }
+        Ok(ring)
+    }
+
+    fn fill(&mut self, ctx: &Context) -> Result<()> {
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(self.pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(FRAMES_IN_FLIGHT as u32);
+        let cmds = unsafe { ctx.device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?;
+        for cmd in cmds {
+            // Signalled, so the first wait on each slot returns at once.
+            let fence_ci = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
+            let fence = unsafe { ctx.device.create_fence(&fence_ci, None) }.vk("vkCreateFence")?;
+            let timer = match PassTimer::new(ctx) {
+                Ok(t) => t,
+                Err(e) => {
+                    unsafe { ctx.device.destroy_fence(fence, None) };
+                    return Err(e);
+                }
+            };
+            self.slots.push(Slot { cmd, fence, timer });
+        }
+        Ok(())
+    }
+
+    /// Waits for the next slot's previous frame, returns its pass times, and starts recording.
+    pub fn begin(&mut self, ctx: &Context) -> Result<(Frame<'_>, Option<Vec<PassTime>>)> {
+        let slot = self.next;
+        let earlier = self.wait(ctx, slot)?;
+        let s = &mut self.slots[slot];
+        unsafe {
+            ctx.device.reset_fences(&[s.fence]).vk("vkResetFences")?;
+            ctx.device.reset_command_buffer(s.cmd, vk::CommandBufferResetFlags::empty()).vk("vkResetCommandBuffer")?;
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            ctx.device.begin_command_buffer(s.cmd, &begin).vk("vkBeginCommandBuffer")?;
+        }
+        s.timer.reset(ctx, s.cmd);
+        Ok((Frame { slot, cmd: s.cmd, timer: &mut s.timer }, earlier))
+    }
+
+    /// Ends and submits the frame begun last.
+    pub fn submit(&mut self, ctx: &Context, slot: usize) -> Result<()> {
+        let s = &self.slots[slot];
+        unsafe {
+            ctx.device.end_command_buffer(s.cmd).vk("vkEndCommandBuffer")?;
+            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(s.cmd)];
+            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            ctx.device.queue_submit2(ctx.queue, &submit, s.fence).vk("vkQueueSubmit2")?;
+        }
+        self.next = (slot + 1) % FRAMES_IN_FLIGHT;
+        Ok(())
+    }
+
+    /// Waits for slot `slot`'s frame to finish and returns its pass times (once).
+    pub fn wait(&mut self, ctx: &Context, slot: usize) -> Result<Option<Vec<PassTime>>> {
+        let s = &mut self.slots[slot];
+        unsafe { ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        s.timer.collect(ctx)
+    }
+
+    /// Waits for every frame in flight; returns their pass times, oldest first.
+    pub fn drain(&mut self, ctx: &Context) -> Result<Vec<Vec<PassTime>>> {
+        let mut out = Vec::new();
+        for k in 0..FRAMES_IN_FLIGHT {
+            let slot = (self.next + k) % FRAMES_IN_FLIGHT;
+            out.extend(self.wait(ctx, slot)?);
+        }
+        Ok(out)
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        for s in self.slots {
+            unsafe { ctx.device.destroy_fence(s.fence, None) };
+            s.timer.destroy(ctx);
+        }
+        unsafe { ctx.device.destroy_command_pool(self.pool, None) };
+    }
+}

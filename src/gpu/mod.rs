@@ -1,0 +1,24 @@
+//! The only Vulkan plumbing: context, memory, targets, barriers, pipelines, shaders,
+//! timestamps, frames and readback. Nothing here knows about shadows.
+
+mod barrier;
+mod context;
+mod debug;
+mod frames;
+mod memory;
+mod pipeline;
+mod render;
+pub mod shaders;
+mod target;
+mod timestamps;
+mod upload;
+
+pub use barrier::{Access, copy_to_host, transition};
+pub use context::{Context, ContextOptions, DeviceInfo};
+pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
+pub use memory::{Buffer, PerFrame};
+pub use pipeline::{Binding, DepthState, Descriptor, Pipeline, PipelineDesc, VertexInput};
+pub use render::{Attachment, RenderPass, draw_fullscreen};
+pub use target::{Target, TargetDesc, ensure};
+pub use timestamps::{PassTime, PassTimer};
+pub use upload::upload;

@@ -1,0 +1,236 @@
+//! Graphics pipelines for dynamic rendering, each with one push-descriptor set: a pass pushes
+//! its inputs when it records, so no descriptor pools or set lifetimes exist.
+
+use ash::vk;
+
+use super::Context;
+use super::target::Target;
+use crate::error::{Error, Result, VkContext};
+
+/// What a binding of set 0 holds; bindings are numbered in the order given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Binding {
+    Uniform,
+    Storage,
+    /// A target read through the context's nearest clamp sampler.
+    Sampled,
+}
+
+impl Binding {
+    fn ty(self) -> vk::DescriptorType {
+        match self {
+            Binding::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+            Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
+            Binding::Sampled => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+}
+
+/// A pass input, in binding order.
+pub enum Descriptor<'a> {
+    Buffer(vk::DescriptorBufferInfo),
+    Image(&'a Target),
+}
+
+/// Vertex streams a pipeline reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexInput {
+    /// Generated in the shader (full-screen triangle).
+    None,
+    /// `Vertex` with only its position read (location 0).
+    Position,
+    /// `Vertex`: position (location 0) and normal (location 1).
+    PositionNormal,
+}
+
+/// Depth test and write of a pipeline.
+#[derive(Clone, Copy, Debug)]
+pub struct DepthState {
+    pub format: vk::Format,
+    pub compare: vk::CompareOp,
+}
+
+/// A graphics pipeline's description.
+pub struct PipelineDesc<'a> {
+    pub name: &'static str,
+    pub vertex: &'a [u32],
+    pub fragment: &'a [u32],
+    /// Bindings of set 0, with the stages that read them.
+    pub bindings: &'a [(Binding, vk::ShaderStageFlags)],
+    pub vertex_input: VertexInput,
+    pub color_formats: &'a [vk::Format],
+    pub depth: Option<DepthState>,
+}
+
+/// A pipeline, its layout and its push-descriptor set layout.
+pub struct Pipeline {
+    pub name: &'static str,
+    pub(crate) pipeline: vk::Pipeline,
+    layout: vk::PipelineLayout,
+    set_layout: vk::DescriptorSetLayout,
+    bindings: Vec<Binding>,
+}
+
+impl Pipeline {
+    pub fn new(ctx: &Context, desc: &PipelineDesc<'_>) -> Result<Self> {
+        let d = &ctx.device;
+        let samplers = [ctx.nearest_sampler];
+        let layout_bindings: Vec<_> = desc
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(i, (b, stages))| {
+                let binding = vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(b.ty())
+                    .descriptor_count(1)
+                    .stage_flags(*stages);
+                if *b == Binding::Sampled { binding.immutable_samplers(&samplers) } else { binding }
+            })
+            .collect();
+        let set_ci = vk::DescriptorSetLayoutCreateInfo::default()
+            .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
+            .bindings(&layout_bindings);
+        let set_layout = unsafe { d.create_descriptor_set_layout(&set_ci, None) }.vk("vkCreateDescriptorSetLayout")?;
+        let mut pipeline = Pipeline {
+            name: desc.name,
+            pipeline: vk::Pipeline::null(),
+            layout: vk::PipelineLayout::null(),
+            set_layout,
+            bindings: desc.bindings.iter().map(|(b, _)| *b).collect(),
+        };
+        // On failure, `destroy` releases what was made so far (null handles are ignored).
+        if let Err(e) = pipeline.build(ctx, desc) {
+            pipeline.destroy(ctx);
+            return Err(e);
+        }
+        ctx.name(pipeline.pipeline, desc.name);
+        Ok(pipeline)
+    }
+
+    fn build(&mut self, ctx: &Context, desc: &PipelineDesc<'_>) -> Result<()> {
+        let d = &ctx.device;
+        let set_layouts = [self.set_layout];
+        let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+        self.layout = unsafe { d.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")?;
+
+        let vert = shader_module(ctx, desc.vertex)?;
+        let frag = match shader_module(ctx, desc.fragment) {
+            Ok(f) => f,
+            Err(e) => {
+                unsafe { d.destroy_shader_module(vert, None) };
+                return Err(e);
+            }
+        };
+        let stages = [
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(frag).name(c"main"),
+        ];
+        let stride = std::mem::size_of::<crate::scene::Vertex>() as u32;
+        let vb = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
+        let attrs = [
+            vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
+            vk::VertexInputAttributeDescription { location: 1, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
+        ];
+        let vertex_input = match desc.vertex_input {
+            VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
+            VertexInput::Position => {
+                vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&vb).vertex_attribute_descriptions(&attrs[..1])
+            }
+            VertexInput::PositionNormal => {
+                vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&vb).vertex_attribute_descriptions(&attrs)
+            }
+        };
+        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+        // Two-sided everywhere: plates and open meshes have no inside to cull.
+        let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .polygon_mode(vk::PolygonMode::FILL)
+            .cull_mode(vk::CullModeFlags::NONE)
+            .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+            .line_width(1.0);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let depth = vk::PipelineDepthStencilStateCreateInfo::default()
+            .depth_test_enable(desc.depth.is_some())
+            .depth_write_enable(desc.depth.is_some())
+            .depth_compare_op(desc.depth.map_or(vk::CompareOp::ALWAYS, |d| d.compare));
+        let blend: Vec<_> = desc
+            .color_formats
+            .iter()
+            .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
+            .collect();
+        let blend_state = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
+        let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+        let mut rendering = vk::PipelineRenderingCreateInfo::default()
+            .color_attachment_formats(desc.color_formats)
+            .depth_attachment_format(desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format));
+        let ci = vk::GraphicsPipelineCreateInfo::default()
+            .stages(&stages)
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly)
+            .viewport_state(&viewport)
+            .rasterization_state(&raster)
+            .multisample_state(&multisample)
+            .depth_stencil_state(&depth)
+            .color_blend_state(&blend_state)
+            .dynamic_state(&dynamic_state)
+            .layout(self.layout)
+            .push_next(&mut rendering);
+        let created = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[ci], None) };
+        unsafe {
+            d.destroy_shader_module(vert, None);
+            d.destroy_shader_module(frag, None);
+        }
+        self.pipeline = created.map_err(|(_, result)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result })?[0];
+        Ok(())
+    }
+
+    /// Binds the pipeline and pushes its inputs, which must match the bindings in order.
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, inputs: &[Descriptor<'_>]) {
+        assert_eq!(inputs.len(), self.bindings.len(), "{}: wrong number of inputs", self.name);
+        let buffers: Vec<[vk::DescriptorBufferInfo; 1]> = inputs
+            .iter()
+            .map(|i| match i {
+                Descriptor::Buffer(b) => [*b],
+                Descriptor::Image(_) => [vk::DescriptorBufferInfo::default()],
+            })
+            .collect();
+        let images: Vec<[vk::DescriptorImageInfo; 1]> = inputs
+            .iter()
+            .map(|i| match i {
+                Descriptor::Image(t) => [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: t.view, image_layout: t.last.layout }],
+                Descriptor::Buffer(_) => [vk::DescriptorImageInfo::default()],
+            })
+            .collect();
+        let writes: Vec<_> = self
+            .bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let w = vk::WriteDescriptorSet::default().dst_binding(i as u32).descriptor_type(b.ty());
+                match inputs[i] {
+                    Descriptor::Buffer(_) => w.buffer_info(&buffers[i]),
+                    Descriptor::Image(_) => w.image_info(&images[i]),
+                }
+            })
+            .collect();
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            ctx.push_descriptor.cmd_push_descriptor_set(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &writes);
+        }
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+fn shader_module(ctx: &Context, words: &[u32]) -> Result<vk::ShaderModule> {
+    let ci = vk::ShaderModuleCreateInfo::default().code(words);
+    unsafe { ctx.device.create_shader_module(&ci, None) }.vk("vkCreateShaderModule")
+}

@@ -1,0 +1,77 @@
+//! Dynamic rendering scopes: attachments, clears, and the viewport covering them.
+
+use ash::vk;
+
+use super::Context;
+use super::target::Target;
+
+/// A target drawn into, cleared first or loaded.
+pub struct Attachment<'a> {
+    pub target: &'a Target,
+    pub clear: Option<vk::ClearValue>,
+}
+
+impl<'a> Attachment<'a> {
+    pub fn clear_color(target: &'a Target, rgba: [f32; 4]) -> Self {
+        Attachment { target, clear: Some(vk::ClearValue { color: vk::ClearColorValue { float32: rgba } }) }
+    }
+
+    pub fn clear_depth(target: &'a Target, depth: f32) -> Self {
+        Attachment {
+            target,
+            clear: Some(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth, stencil: 0 } }),
+        }
+    }
+
+    fn info(&self) -> vk::RenderingAttachmentInfo<'static> {
+        vk::RenderingAttachmentInfo::default()
+            .image_view(self.target.view)
+            .image_layout(self.target.last.layout)
+            .load_op(if self.clear.is_some() { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD })
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(self.clear.unwrap_or_default())
+    }
+}
+
+/// A dynamic rendering scope; `end` closes it.
+pub struct RenderPass;
+
+impl RenderPass {
+    /// Begins rendering into `colors` and `depth` (all the same size, already transitioned) and
+    /// sets the viewport and scissor to cover them.
+    pub fn begin(ctx: &Context, cmd: vk::CommandBuffer, colors: &[Attachment<'_>], depth: Option<Attachment<'_>>) -> Self {
+        let extent = colors.first().or(depth.as_ref()).expect("a pass draws into something").target.extent();
+        let color_infos: Vec<_> = colors.iter().map(Attachment::info).collect();
+        let depth_info = depth.as_ref().map(Attachment::info);
+        let mut info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .layer_count(1)
+            .color_attachments(&color_infos);
+        if let Some(d) = &depth_info {
+            info = info.depth_attachment(d);
+        }
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        unsafe {
+            ctx.device.cmd_begin_rendering(cmd, &info);
+            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            ctx.device.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+        }
+        RenderPass
+    }
+
+    pub fn end(self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+    }
+}
+
+/// Draws the full-screen triangle of `glsl/common/fullscreen.vert`.
+pub fn draw_fullscreen(ctx: &Context, cmd: vk::CommandBuffer) {
+    unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+}

@@ -1,0 +1,92 @@
+//! Named GPU timestamps: each pass writes a begin and an end query; results are read when the
+//! frame's fence has signalled (one frame late, as hypermine's `draw.rs` does), converted with
+//! `timestampPeriod` and masked to the queue's valid bits.
+
+use ash::vk;
+
+use super::Context;
+use crate::error::{Result, VkContext};
+
+/// Passes a frame may time.
+const MAX_PASSES: u32 = 32;
+
+/// The GPU time of one pass in one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTime {
+    pub name: &'static str,
+    pub ms: f64,
+}
+
+/// One frame's query pool and the pass names written into it.
+pub struct PassTimer {
+    pool: vk::QueryPool,
+    names: Vec<&'static str>,
+    open: bool,
+    recorded: bool,
+}
+
+impl PassTimer {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let ci = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(MAX_PASSES * 2);
+        let pool = unsafe { ctx.device.create_query_pool(&ci, None) }.vk("vkCreateQueryPool")?;
+        ctx.name(pool, "pass timestamps");
+        Ok(PassTimer { pool, names: Vec::new(), open: false, recorded: false })
+    }
+
+    /// Starts a frame's recording: queries must be reset before they are written again.
+    pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe { ctx.device.cmd_reset_query_pool(cmd, self.pool, 0, MAX_PASSES * 2) };
+        self.names.clear();
+        self.recorded = true;
+    }
+
+    /// Opens pass `name`: a timestamp and a debug label of the same name.
+    pub fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &'static str) {
+        assert!(!self.open, "pass {name} opened inside another");
+        assert!((self.names.len() as u32) < MAX_PASSES, "more than {MAX_PASSES} passes in a frame");
+        let index = self.names.len() as u32 * 2;
+        self.names.push(name);
+        self.open = true;
+        if let Some(du) = &ctx.debug_utils {
+            let label = std::ffi::CString::new(name).unwrap_or_default();
+            unsafe { du.cmd_begin_debug_utils_label(cmd, &vk::DebugUtilsLabelEXT::default().label_name(&label)) };
+        }
+        unsafe { ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::TOP_OF_PIPE, self.pool, index) };
+    }
+
+    /// Closes the open pass once all its work has finished.
+    pub fn end(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        assert!(self.open, "no pass is open");
+        self.open = false;
+        let index = self.names.len() as u32 * 2 - 1;
+        unsafe { ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::BOTTOM_OF_PIPE, self.pool, index) };
+        if let Some(du) = &ctx.debug_utils {
+            unsafe { du.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    /// The recorded frame's pass times; call only after its fence signalled. `None` when nothing
+    /// was recorded since the last call.
+    pub fn collect(&mut self, ctx: &Context) -> Result<Option<Vec<PassTime>>> {
+        if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
+            return Ok(None);
+        }
+        let mut raw = vec![0u64; self.names.len() * 2];
+        unsafe { ctx.device.get_query_pool_results(self.pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64) }
+            .vk("vkGetQueryPoolResults")?;
+        let bits = ctx.info.timestamp_valid_bits;
+        let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
+        let period = ctx.info.timestamp_period_ns as f64;
+        Ok(Some(
+            self.names
+                .iter()
+                .zip(raw.chunks_exact(2))
+                .map(|(&name, t)| PassTime { name, ms: ((t[1] & mask).wrapping_sub(t[0] & mask) & mask) as f64 * period * 1e-6 })
+                .collect(),
+        ))
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}

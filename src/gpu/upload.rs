@@ -1,0 +1,67 @@
+//! One-time uploads of static data (meshes) into device-local buffers.
+
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+use super::Context;
+use super::memory::Buffer;
+use crate::error::{Result, VkContext};
+
+/// Creates a device-local buffer holding `bytes`, through a staging buffer, and waits for it.
+pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    let size = bytes.len() as u64;
+    let mut staging = Buffer::new(ctx, "staging", size, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
+    staging.write(0, bytes);
+    let dst = match Buffer::new(ctx, name, size, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly) {
+        Ok(b) => b,
+        Err(e) => {
+            staging.destroy(ctx);
+            return Err(e);
+        }
+    };
+    let result = submit_and_wait(ctx, |cmd| unsafe {
+        ctx.device.cmd_copy_buffer(cmd, staging.buffer, dst.buffer, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size }]);
+        // Later frames read the data as vertices and indices: order them after the copy.
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COPY)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT | vk::PipelineStageFlags2::INDEX_INPUT)
+            .dst_access_mask(vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::INDEX_READ)];
+        ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
+    });
+    staging.destroy(ctx);
+    match result {
+        Ok(()) => Ok(dst),
+        Err(e) => {
+            dst.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
+fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+    let d = &ctx.device;
+    let pool_ci = vk::CommandPoolCreateInfo::default()
+        .queue_family_index(ctx.queue_family)
+        .flags(vk::CommandPoolCreateFlags::TRANSIENT);
+    let pool = unsafe { d.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
+    let run = || -> Result<()> {
+        let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).level(vk::CommandBufferLevel::PRIMARY).command_buffer_count(1);
+        let cmd = unsafe { d.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        unsafe { d.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
+        record(cmd);
+        unsafe { d.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
+        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.vk("vkCreateFence")?;
+        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
+        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+        let waited = unsafe { d.queue_submit2(ctx.queue, &submit, fence) }
+            .vk("vkQueueSubmit2")
+            .and_then(|()| unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences"));
+        unsafe { d.destroy_fence(fence, None) };
+        waited
+    };
+    let result = run();
+    unsafe { d.destroy_command_pool(pool, None) };
+    result
+}

@@ -1,0 +1,43 @@
+//! Rust mirrors of `glsl/common/interface.glsl`: one definition of every struct that crosses to
+//! the GPU, checked for size here (only vec4/mat4 members, so std140 and std430 agree).
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec4};
+
+/// Camera and light for every pass of a frame.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct FrameGlobals {
+    pub view_proj: Mat4,
+    pub inv_view_proj: Mat4,
+    pub camera_position: Vec4,
+    pub camera_forward: Vec4,
+    pub light: Vec4,
+    pub light_color: Vec4,
+    pub ambient: Vec4,
+    pub sky: Vec4,
+    pub viewport: Vec4,
+}
+
+/// One drawn object, indexed by the draw's first instance.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ObjectData {
+    pub model: Mat4,
+    pub normal_matrix: Mat4,
+    pub albedo: Vec4,
+}
+
+/// A perspective view from the light.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightView {
+    pub view: Mat4,
+    pub view_proj: Mat4,
+    pub extent: Vec4,
+    pub bias: Vec4,
+}
+
+const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
+const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
+const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 2 * 16);

@@ -1,0 +1,31 @@
+//! softshadow: real-time fake soft shadows with raw Vulkan.
+//!
+//! The frame (DESIGN.md §1): a camera prepass (depth + normal), a technique's passes ending in
+//! the visibility image V (1 = light fully visible), and a composite (ambient + V·Lambert). Every
+//! technique writes the same V for the same pixels, so they are interchangeable and comparable.
+//!
+//! ```no_run
+//! use softshadow::{Engine, FrameSettings, gpu::ContextOptions, scene::Scene};
+//! let mut scene = Scene::load("scenes/default.toml")?;
+//! let settings = FrameSettings::from_scene(&scene)?;
+//! let mut engine = Engine::headless(&ContextOptions::from_env())?;
+//! for frame in 0..100 {
+//!     scene.objects[0].transform.position.x = (frame as f32 * 0.05).sin();
+//!     engine.render(&scene, &settings)?;
+//! }
+//! let capture = engine.render_and_capture(&scene, &settings)?;
+//! capture.save_color("out/color.png".as_ref())?;
+//! # Ok::<(), softshadow::Error>(())
+//! ```
+
+pub mod error;
+pub mod geometry;
+pub mod gpu;
+mod gpu_types;
+pub mod measure;
+pub mod renderer;
+pub mod scene;
+pub mod technique;
+
+pub use error::{Error, Result};
+pub use renderer::{Capture, Engine, FrameSettings, FrameTimings};

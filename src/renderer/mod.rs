@@ -1,0 +1,389 @@
+//! The frame of DESIGN.md §1: prepass → technique → composite → readback, and the game-loop
+//! API around it. Create an [`Engine`] once, change the scene between frames, render, read
+//! timings and images; nothing assumes one frame per process.
+
+mod capture;
+mod draw;
+mod passes;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use ash::vk;
+use bytemuck::{bytes_of, cast_slice};
+use glam::{Mat4, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+
+pub use capture::Capture;
+pub use draw::Draw;
+use draw::MeshCache;
+use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass};
+
+use crate::error::Result;
+use crate::geometry::{Aabb, CameraProjection, Hexahedron, intersection_points};
+use crate::gpu::{
+    Access, Buffer, Context, ContextOptions, DeviceInfo, FRAMES_IN_FLIGHT, FrameRing, PassTime, PerFrame, Target, TargetDesc,
+    copy_to_host, transition,
+};
+use crate::gpu_types::{FrameGlobals, ObjectData};
+use crate::scene::{Ground, Mesh, Scene, primitives};
+use crate::technique::{self, FrameInputs, Params, Technique};
+
+/// Format of the visibility image V (DESIGN.md §3).
+pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R16_UNORM;
+
+const AMBIENT: f32 = 0.15;
+const SKY: [f32; 3] = [0.55, 0.62, 0.72];
+const GROUND_COLOR: Vec3 = Vec3::new(0.75, 0.75, 0.72);
+
+/// What to render a frame at: size and technique with its knobs.
+#[derive(Clone, Debug)]
+pub struct FrameSettings {
+    pub width: u32,
+    pub height: u32,
+    pub params: Params,
+}
+
+impl FrameSettings {
+    /// The scene file's `[render]` table.
+    pub fn from_scene(scene: &Scene) -> Result<Self> {
+        let info = technique::knobs::find(&scene.render.technique)?;
+        let mut params = Params::defaults(info);
+        params.apply(scene.render.params.iter().map(|(k, v)| (k.as_str(), v.as_str())))?;
+        Ok(FrameSettings { width: scene.render.width, height: scene.render.height, params })
+    }
+}
+
+/// GPU pass times of one finished frame, and the CPU time its recording took.
+#[derive(Clone, Debug)]
+pub struct FrameTimings {
+    pub passes: Vec<PassTime>,
+    pub cpu_record_ms: f64,
+}
+
+/// The camera-sized targets every technique shares.
+pub struct CameraTargets {
+    pub depth: Target,
+    pub normal: Target,
+    pub albedo: Target,
+    pub visibility: Target,
+    pub color: Target,
+}
+
+impl CameraTargets {
+    fn new(ctx: &Context, w: u32, h: u32) -> Result<Self> {
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let readback = vk::ImageUsageFlags::TRANSFER_SRC;
+        let descs = [
+            TargetDesc::depth("camera depth", w, h).usage(sampled),
+            TargetDesc::color("camera normal", NORMAL_FORMAT, w, h),
+            TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
+            TargetDesc::color("visibility", VISIBILITY_FORMAT, w, h).usage(readback),
+            TargetDesc::color("color", COLOR_FORMAT, w, h).usage(readback),
+        ];
+        let mut made = Vec::new();
+        for desc in descs {
+            match Target::new(ctx, desc) {
+                Ok(t) => made.push(t),
+                Err(e) => {
+                    made.into_iter().for_each(|t| t.destroy(ctx));
+                    return Err(e);
+                }
+            }
+        }
+        let [depth, normal, albedo, visibility, color] = <[Target; 5]>::try_from(made).ok().expect("five targets");
+        Ok(CameraTargets { depth, normal, albedo, visibility, color })
+    }
+
+    fn extent(&self) -> vk::Extent2D {
+        self.color.extent()
+    }
+
+    fn destroy(self, ctx: &Context) {
+        for t in [self.depth, self.normal, self.albedo, self.visibility, self.color] {
+            t.destroy(ctx);
+        }
+    }
+}
+
+/// Owns the GPU and everything on it; renders scenes frame after frame.
+pub struct Engine {
+    frames: Option<FrameRing>,
+    prepass: Option<Prepass>,
+    composite: Option<Composite>,
+    meshes: MeshCache,
+    globals: Option<PerFrame>,
+    objects: Option<PerFrame>,
+    targets: Option<CameraTargets>,
+    readback: Option<Buffer>,
+    technique: Option<(&'static str, Box<dyn Technique>)>,
+    ground_mesh: Arc<Mesh>,
+    frame_number: u64,
+    timings: Vec<FrameTimings>,
+    cpu_ms: Vec<f64>,
+    // Declared last: dropped after everything above is destroyed in `Drop`.
+    ctx: Context,
+}
+
+impl Engine {
+    /// An engine rendering offscreen (tests, the command line, benchmarks).
+    pub fn headless(options: &ContextOptions) -> Result<Self> {
+        let ctx = Context::headless(options)?;
+        let mut engine = Engine {
+            frames: None,
+            prepass: None,
+            composite: None,
+            meshes: MeshCache::default(),
+            globals: None,
+            objects: None,
+            targets: None,
+            readback: None,
+            technique: None,
+            ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
+            frame_number: 0,
+            timings: Vec::new(),
+            cpu_ms: Vec::new(),
+            ctx,
+        };
+        // On error, `Drop` destroys whatever was made.
+        let ctx = &engine.ctx;
+        engine.frames = Some(FrameRing::new(ctx)?);
+        engine.prepass = Some(Prepass::new(ctx)?);
+        engine.composite = Some(Composite::new(ctx)?);
+        let size = std::mem::size_of::<FrameGlobals>() as u64;
+        engine.globals = Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
+        Ok(engine)
+    }
+
+    pub fn device(&self) -> &DeviceInfo {
+        &self.ctx.info
+    }
+
+    pub fn context(&self) -> &Context {
+        &self.ctx
+    }
+
+    /// Renders one frame. Its GPU times become available a frame or two later, in
+    /// [`Engine::take_timings`].
+    pub fn render(&mut self, scene: &Scene, settings: &FrameSettings) -> Result<()> {
+        self.frame(scene, settings, false).map(|_| ())
+    }
+
+    /// Renders one frame and reads its color and visibility images back (waits for the GPU).
+    pub fn render_and_capture(&mut self, scene: &Scene, settings: &FrameSettings) -> Result<Capture> {
+        Ok(self.frame(scene, settings, true)?.expect("capture requested"))
+    }
+
+    /// Timings of every frame finished since the last call, oldest first.
+    pub fn take_timings(&mut self) -> Vec<FrameTimings> {
+        std::mem::take(&mut self.timings)
+    }
+
+    /// Waits for every frame in flight, so that their timings are available.
+    pub fn flush(&mut self) -> Result<()> {
+        let frames = self.frames.as_mut().expect("engine is built");
+        let done = frames.drain(&self.ctx)?;
+        self.push_timings(done);
+        Ok(())
+    }
+
+    /// Destroys everything and returns the validation errors recorded over the engine's life,
+    /// including objects left alive at device destruction.
+    pub fn finish(mut self) -> Vec<String> {
+        self.destroy_resources();
+        self.ctx.destroy();
+        self.ctx.validation_errors()
+    }
+
+    fn push_timings(&mut self, done: impl IntoIterator<Item = Vec<PassTime>>) {
+        for passes in done {
+            let cpu_record_ms = if self.cpu_ms.is_empty() { 0.0 } else { self.cpu_ms.remove(0) };
+            self.timings.push(FrameTimings { passes, cpu_record_ms });
+        }
+    }
+
+    fn frame(&mut self, scene: &Scene, settings: &FrameSettings, capture: bool) -> Result<Option<Capture>> {
+        scene.validate()?;
+        let (w, h) = (settings.width, settings.height);
+        self.ensure_targets(w, h)?;
+        self.ensure_technique(settings.params.technique)?;
+
+        let ctx = &self.ctx;
+        let frames = self.frames.as_mut().expect("engine is built");
+        let (mut frame, earlier) = frames.begin(ctx)?;
+        let started = Instant::now();
+        let number = self.frame_number;
+        self.frame_number += 1;
+        // The fence just waited on covers every frame up to `number - FRAMES_IN_FLIGHT`.
+        if let Some(completed) = number.checked_sub(FRAMES_IN_FLIGHT as u64) {
+            self.meshes.evict(ctx, completed);
+        }
+
+        // Draw list: the scene's objects, then the ground.
+        let mut objects = Vec::with_capacity(scene.objects.len() + 1);
+        let mut draws = Vec::with_capacity(scene.objects.len() + 1);
+        for o in &scene.objects {
+            let model = o.transform.matrix();
+            let bounds = o.mesh.bounds.transformed(&model);
+            let instance = objects.len() as u32;
+            draws.push(self.meshes.draw(ctx, &o.mesh, number, instance, bounds, (o.casts, o.receives))?);
+            objects.push(object_data(model, Mat4::from_mat3(o.normal_matrix()), o.color, o.receives));
+        }
+        if let Some(g) = &scene.ground {
+            let model = ground_model(g);
+            let instance = objects.len() as u32;
+            draws.push(self.meshes.draw(ctx, &self.ground_mesh, number, instance, g.bounds(), (false, true))?);
+            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, true));
+        }
+        let bytes: &[u8] = cast_slice(&objects);
+        if self.objects.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
+            // Grows only; the old buffer may still be read by the frame in flight.
+            ctx.wait_idle()?;
+            if let Some(old) = self.objects.take() {
+                old.destroy(ctx);
+            }
+            let size = (bytes.len() as u64).next_power_of_two();
+            self.objects = Some(PerFrame::new(ctx, "objects", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::STORAGE_BUFFER)?);
+        }
+        let object_buffer = self.objects.as_mut().expect("ensured");
+        if !bytes.is_empty() {
+            object_buffer.write(frame.slot, bytes);
+        }
+
+        let aspect = w as f32 / h as f32;
+        let cam = &scene.camera;
+        let camera = CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, aspect, &scene.bounds());
+        let globals = FrameGlobals {
+            view_proj: camera.view_proj,
+            inv_view_proj: camera.inv_view_proj,
+            camera_position: cam.position.extend(1.0),
+            camera_forward: camera.forward.extend(0.0),
+            light: scene.light.position.extend(scene.light.radius),
+            light_color: Vec4::ONE,
+            ambient: Vec4::splat(AMBIENT),
+            sky: Vec3::from(SKY).extend(1.0),
+            viewport: Vec4::new(w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32),
+        };
+        let globals_buffer = self.globals.as_mut().expect("engine is built");
+        globals_buffer.write(frame.slot, bytes_of(&globals));
+        let globals_range = globals_buffer.range(frame.slot);
+        let objects_range = object_buffer.range(frame.slot);
+        let receivers = receivers_in_view(&camera.frustum, &draws);
+
+        let targets = self.targets.as_mut().expect("ensured");
+        self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, [globals_range, objects_range], &draws);
+        let (_, technique) = self.technique.as_mut().expect("ensured");
+        let mut inputs = FrameInputs {
+            ctx,
+            cmd: frame.cmd,
+            slot: frame.slot,
+            timer: &mut *frame.timer,
+            scene,
+            camera: &camera,
+            globals: globals_range,
+            objects: objects_range,
+            draws: &draws,
+            depth: &targets.depth,
+            normal: &targets.normal,
+            receivers_in_view: &receivers,
+        };
+        technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
+        self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range);
+        if capture {
+            let size = capture::readback_size(w, h);
+            if self.readback.as_ref().is_none_or(|b| b.size != size) {
+                if let Some(old) = self.readback.take() {
+                    old.destroy(ctx);
+                }
+                let usage = vk::BufferUsageFlags::TRANSFER_DST;
+                self.readback = Some(Buffer::new(ctx, "readback", size, usage, MemoryLocation::GpuToCpu)?);
+            }
+            let readback = self.readback.as_ref().expect("ensured");
+            transition(ctx, frame.cmd, &mut [(&mut targets.color, Access::COPY_READ, false), (&mut targets.visibility, Access::COPY_READ, false)]);
+            capture::record_copies(ctx, frame.cmd, targets, readback);
+            copy_to_host(ctx, frame.cmd);
+        }
+        let slot = frame.slot;
+        let frames = self.frames.as_mut().expect("engine is built");
+        frames.submit(ctx, slot)?;
+        self.cpu_ms.push(started.elapsed().as_secs_f64() * 1e3);
+        self.push_timings(earlier);
+        if !capture {
+            return Ok(None);
+        }
+        let frames = self.frames.as_mut().expect("engine is built");
+        let done = frames.wait(&self.ctx, slot)?;
+        self.push_timings(done);
+        Ok(Some(Capture::read(self.readback.as_ref().expect("ensured"), w, h)))
+    }
+
+    fn ensure_targets(&mut self, w: u32, h: u32) -> Result<()> {
+        if self.targets.as_ref().is_some_and(|t| t.extent() == vk::Extent2D { width: w, height: h }) {
+            return Ok(());
+        }
+        if let Some(old) = self.targets.take() {
+            self.ctx.wait_idle()?;
+            old.destroy(&self.ctx);
+        }
+        self.targets = Some(CameraTargets::new(&self.ctx, w, h)?);
+        Ok(())
+    }
+
+    fn ensure_technique(&mut self, info: &'static technique::TechniqueInfo) -> Result<()> {
+        if self.technique.as_ref().is_some_and(|(name, _)| *name == info.name) {
+            return Ok(());
+        }
+        if let Some((_, old)) = self.technique.take() {
+            self.ctx.wait_idle()?;
+            old.destroy(&self.ctx);
+        }
+        self.technique = Some((info.name, technique::create(&self.ctx, info)?));
+        Ok(())
+    }
+
+    fn destroy_resources(&mut self) {
+        let ctx = &self.ctx;
+        // Nothing more can fail usefully here; the device is going away.
+        let _ = ctx.wait_idle();
+        if let Some((_, t)) = self.technique.take() {
+            t.destroy(ctx);
+        }
+        std::mem::take(&mut self.meshes).destroy(ctx);
+        self.targets.take().into_iter().for_each(|t| t.destroy(ctx));
+        self.readback.take().into_iter().for_each(|b| b.destroy(ctx));
+        self.globals.take().into_iter().chain(self.objects.take()).for_each(|b| b.destroy(ctx));
+        self.prepass.take().into_iter().for_each(|p| p.destroy(ctx));
+        self.composite.take().into_iter().for_each(|p| p.destroy(ctx));
+        self.frames.take().into_iter().for_each(|f| f.destroy(ctx));
+    }
+}
+
+impl Drop for Engine {
+    fn drop(&mut self) {
+        self.destroy_resources();
+    }
+}
+
+fn object_data(model: Mat4, normal: Mat4, color: Vec3, receives: bool) -> ObjectData {
+    ObjectData { model, normal_matrix: normal, albedo: color.extend(if receives { 1.0 } else { 0.0 }) }
+}
+
+/// The ground is the unit plate scaled to the ground's square, at its height.
+fn ground_model(g: &Ground) -> Mat4 {
+    let side = 2.0 * g.half_size;
+    Mat4::from_scale_rotation_translation(Vec3::new(side, 1.0, side), glam::Quat::IDENTITY, Vec3::new(0.0, g.height, 0.0))
+}
+
+/// Points spanning the visible part of every receiver: each receiver's box clipped by the
+/// camera frustum. Flat receivers are thickened by a hair so clipping keeps them.
+fn receivers_in_view(frustum: &Hexahedron, draws: &[Draw]) -> Vec<Vec3> {
+    draws
+        .iter()
+        .filter(|d| d.receives)
+        .flat_map(|d| {
+            let pad = Vec3::splat(1e-4 * (d.bounds.max - d.bounds.min).max_element().max(f32::MIN_POSITIVE));
+            let grown = Aabb { min: d.bounds.min - pad, max: d.bounds.max + pad };
+            intersection_points(frustum, &Hexahedron { corners: grown.corners() })
+        })
+        .collect()
+}

@@ -1,0 +1,124 @@
+//! The passes every technique shares: the camera prepass before it and the composite after it.
+
+use ash::vk;
+
+use super::{CameraTargets, Draw};
+use crate::error::Result;
+use crate::gpu::{
+    Access, Attachment, Binding, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass, VertexInput,
+    draw_fullscreen, shaders, transition,
+};
+
+pub const NORMAL_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+
+/// Camera prepass: reverse-Z depth, world normal with the receives flag, albedo.
+pub struct Prepass {
+    pipeline: Pipeline,
+}
+
+impl Prepass {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let vertex = vk::ShaderStageFlags::VERTEX;
+        let pipeline = Pipeline::new(
+            ctx,
+            &PipelineDesc {
+                name: "prepass",
+                vertex: shaders::PREPASS_SCENE_VERT,
+                fragment: shaders::PREPASS_SCENE_FRAG,
+                bindings: &[(Binding::Uniform, vertex), (Binding::Storage, vertex)],
+                vertex_input: VertexInput::PositionNormal,
+                color_formats: &[NORMAL_FORMAT, ALBEDO_FORMAT],
+                // Reverse Z: nearer is greater.
+                depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),
+            },
+        )?;
+        Ok(Prepass { pipeline })
+    }
+
+    /// Draws everything; leaves depth and normal ready for the technique and the composite.
+    pub fn record(&self, ctx: &Context, frame: &mut Frame<'_>, t: &mut CameraTargets, inputs: [vk::DescriptorBufferInfo; 2], draws: &[Draw]) {
+        let cmd = frame.cmd;
+        frame.timer.begin(ctx, cmd, "prepass");
+        transition(
+            ctx,
+            cmd,
+            &mut [(&mut t.depth, Access::DEPTH_WRITE, true), (&mut t.normal, Access::COLOR_WRITE, true), (&mut t.albedo, Access::COLOR_WRITE, true)],
+        );
+        let pass = RenderPass::begin(
+            ctx,
+            cmd,
+            &[Attachment::clear_color(&t.normal, [0.0; 4]), Attachment::clear_color(&t.albedo, [0.0; 4])],
+            Some(Attachment::clear_depth(&t.depth, 0.0)),
+        );
+        self.pipeline.bind(ctx, cmd, &inputs.map(Descriptor::Buffer));
+        for draw in draws {
+            draw.record(ctx, cmd);
+        }
+        pass.end(ctx, cmd);
+        transition(
+            ctx,
+            cmd,
+            &mut [
+                (&mut t.depth, Access::DEPTH_FRAGMENT_READ, false),
+                (&mut t.normal, Access::FRAGMENT_READ, false),
+                (&mut t.albedo, Access::FRAGMENT_READ, false),
+            ],
+        );
+        frame.timer.end(ctx, cmd);
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}
+
+/// Composite: ambient + V·Lambert into the sRGB color target.
+pub struct Composite {
+    pipeline: Pipeline,
+}
+
+impl Composite {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let f = vk::ShaderStageFlags::FRAGMENT;
+        let pipeline = Pipeline::new(
+            ctx,
+            &PipelineDesc {
+                name: "composite",
+                vertex: shaders::COMMON_FULLSCREEN_VERT,
+                fragment: shaders::COMPOSITE_COMPOSITE_FRAG,
+                bindings: &[(Binding::Uniform, f), (Binding::Sampled, f), (Binding::Sampled, f), (Binding::Sampled, f), (Binding::Sampled, f)],
+                vertex_input: VertexInput::None,
+                color_formats: &[COLOR_FORMAT],
+                depth: None,
+            },
+        )?;
+        Ok(Composite { pipeline })
+    }
+
+    pub fn record(&self, ctx: &Context, frame: &mut Frame<'_>, t: &mut CameraTargets, globals: vk::DescriptorBufferInfo) {
+        let cmd = frame.cmd;
+        frame.timer.begin(ctx, cmd, "composite");
+        transition(ctx, cmd, &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (&mut t.color, Access::COLOR_WRITE, true)]);
+        let pass = RenderPass::begin(ctx, cmd, &[Attachment { target: &t.color, clear: None }], None);
+        self.pipeline.bind(
+            ctx,
+            cmd,
+            &[
+                Descriptor::Buffer(globals),
+                Descriptor::Image(&t.depth),
+                Descriptor::Image(&t.normal),
+                Descriptor::Image(&t.albedo),
+                Descriptor::Image(&t.visibility),
+            ],
+        );
+        draw_fullscreen(ctx, cmd);
+        pass.end(ctx, cmd);
+        frame.timer.end(ctx, cmd);
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+    }
+}

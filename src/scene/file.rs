@@ -1,0 +1,238 @@
+//! The scene file (TOML, metres, right-handed, +Y up) of DESIGN.md §3. Unknown keys, missing
+//! files and nonsense numbers are errors that name the file and the key or line.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::Vec3;
+use serde::Deserialize;
+
+use super::{Camera, Ground, Light, Mesh, Object, RenderSettings, Scene, Transform, primitives};
+use crate::error::{Error, Result};
+use crate::geometry::Projection;
+use crate::technique::knobs;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    camera: CameraFile,
+    light: LightFile,
+    ground: Option<GroundFile>,
+    #[serde(default, rename = "object")]
+    objects: Vec<ObjectFile>,
+    #[serde(default)]
+    render: RenderFile,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraFile {
+    position: [f32; 3],
+    target: [f32; 3],
+    up: Option<[f32; 3]>,
+    fov_y_deg: Option<f32>,
+    ortho_half_height: Option<f32>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightFile {
+    position: [f32; 3],
+    radius: f32,
+    target: Option<[f32; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GroundFile {
+    #[serde(default)]
+    height: f32,
+    #[serde(default = "default_half_size")]
+    half_size: f32,
+}
+
+fn default_half_size() -> f32 {
+    10.0
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Debug)]
+#[serde(rename_all = "lowercase")]
+enum Shape {
+    Box,
+    Sphere,
+    Cylinder,
+    Plate,
+    Mesh,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Scale {
+    Uniform(f32),
+    PerAxis([f32; 3]),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectFile {
+    shape: Shape,
+    name: Option<String>,
+    size: Option<[f32; 3]>,
+    radius: Option<f32>,
+    height: Option<f32>,
+    mesh: Option<String>,
+    #[serde(default)]
+    position: [f32; 3],
+    #[serde(default)]
+    rotation_deg: [f32; 3],
+    scale: Option<Scale>,
+    color: Option<[f32; 3]>,
+    #[serde(default = "yes")]
+    casts: bool,
+    #[serde(default = "yes")]
+    receives: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RenderFile {
+    width: Option<u32>,
+    height: Option<u32>,
+    technique: Option<String>,
+    #[serde(default)]
+    params: toml::Table,
+}
+
+/// Albedos for objects that name no color: distinct, mid-bright, linear RGB.
+const PALETTE: [[f32; 3]; 6] =
+    [[0.80, 0.30, 0.25], [0.25, 0.50, 0.80], [0.85, 0.70, 0.25], [0.35, 0.70, 0.40], [0.65, 0.40, 0.75], [0.80, 0.80, 0.80]];
+
+pub(super) fn load(path: &Path) -> Result<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::scene(path, format!("cannot read the scene file: {e}")))?;
+    parse(&text, path)
+}
+
+pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
+    // toml's message names the line, the column and the offending key.
+    let file: SceneFile = toml::from_str(text).map_err(|e| Error::scene(path, e.to_string().trim_end().to_string()))?;
+    let err = |what: String| Error::scene(path, what);
+    let finite = |key: &str, v: [f32; 3]| -> Result<Vec3> {
+        let v = Vec3::from(v);
+        if v.is_finite() { Ok(v) } else { Err(err(format!("`{key}` must be finite numbers, got {v}"))) }
+    };
+
+    let c = &file.camera;
+    let projection = match (c.fov_y_deg, c.ortho_half_height) {
+        (Some(fov_y_deg), None) => Projection::Perspective { fov_y_deg },
+        (None, Some(half_height)) => Projection::Orthographic { half_height },
+        (None, None) => return Err(err("[camera] needs `fov_y_deg` (perspective) or `ortho_half_height`".into())),
+        (Some(_), Some(_)) => return Err(err("[camera] takes `fov_y_deg` or `ortho_half_height`, not both".into())),
+    };
+    let camera = Camera {
+        position: finite("camera.position", c.position)?,
+        target: finite("camera.target", c.target)?,
+        up: finite("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?,
+        projection,
+    };
+    let light = Light {
+        position: finite("light.position", file.light.position)?,
+        radius: file.light.radius,
+        target: file.light.target.map(|t| finite("light.target", t)).transpose()?,
+    };
+    let ground = file.ground.map(|g| Ground { height: g.height, half_size: g.half_size });
+
+    let base = path.parent().unwrap_or(Path::new("."));
+    let objects = file
+        .objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| object(o, i, base).map_err(|what| err(format!("[[object]] {} ({:?}): {what}", i + 1, o.shape))))
+        .collect::<Result<Vec<_>>>()?;
+
+    let defaults = RenderSettings::default();
+    let render = RenderSettings {
+        width: file.render.width.unwrap_or(defaults.width),
+        height: file.render.height.unwrap_or(defaults.height),
+        technique: file.render.technique.unwrap_or(defaults.technique),
+        params: file
+            .render
+            .params
+            .iter()
+            .map(|(k, v)| match v {
+                toml::Value::Integer(n) => Ok((k.clone(), n.to_string())),
+                toml::Value::Float(x) => Ok((k.clone(), x.to_string())),
+                toml::Value::String(s) => Ok((k.clone(), s.clone())),
+                other => Err(err(format!("[render.params] `{k}` must be a number or a string, got {}", other.type_str()))),
+            })
+            .collect::<Result<_>>()?,
+    };
+    // Check the technique and its knobs now, so a typo fails at load time with the file named.
+    let mut params = knobs::Params::defaults(knobs::find(&render.technique).map_err(|e| err(format!("[render] {e}")))?);
+    params
+        .apply(render.params.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+        .map_err(|e| err(format!("[render.params] {e}")))?;
+
+    let scene = Scene { camera, light, ground, objects, render };
+    scene.validate().map_err(|e| err(e.to_string()))?;
+    Ok(scene)
+}
+
+/// Builds one object; the error text is prefixed with the object's position in the file.
+fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Object, String> {
+    let unused = |keys: &[(&str, bool)]| -> std::result::Result<(), String> {
+        match keys.iter().find(|(_, set)| *set) {
+            Some((key, _)) => Err(format!("`{key}` does not apply to this shape")),
+            None => Ok(()),
+        }
+    };
+    let positive = |key: &str, v: Option<f32>| -> std::result::Result<f32, String> {
+        let v = v.ok_or(format!("needs `{key}`"))?;
+        if v > 0.0 && v.is_finite() { Ok(v) } else { Err(format!("`{key}` must be positive, got {v}")) }
+    };
+    let (size, radius, height, mesh_key) = (o.size.is_some(), o.radius.is_some(), o.height.is_some(), o.mesh.is_some());
+    let mesh = match o.shape {
+        Shape::Box | Shape::Plate => {
+            unused(&[("radius", radius), ("height", height), ("mesh", mesh_key)])?;
+            let s = Vec3::from(o.size.ok_or("needs `size = [x, y, z]`")?);
+            // A plate may be infinitely thin; a box may not.
+            let min_y = if o.shape == Shape::Plate { 0.0 } else { f32::MIN_POSITIVE };
+            if !(s.is_finite() && s.x > 0.0 && s.z > 0.0 && s.y >= min_y) {
+                return Err(format!("`size` must be positive (a plate's y may be 0), got {s}"));
+            }
+            primitives::cuboid(s)
+        }
+        Shape::Sphere => {
+            unused(&[("size", size), ("height", height), ("mesh", mesh_key)])?;
+            primitives::sphere(positive("radius", o.radius)?)
+        }
+        Shape::Cylinder => {
+            unused(&[("size", size), ("mesh", mesh_key)])?;
+            primitives::cylinder(positive("radius", o.radius)?, positive("height", o.height)?)
+        }
+        Shape::Mesh => {
+            unused(&[("size", size), ("radius", radius), ("height", height)])?;
+            let rel = o.mesh.as_ref().ok_or("needs `mesh = \"path.obj\"`")?;
+            Mesh::load_obj(&base.join(rel))
+        }
+    }
+    .map_err(|e| e.to_string())?;
+    let scale = match o.scale {
+        None => Vec3::ONE,
+        Some(Scale::Uniform(s)) => Vec3::splat(s),
+        Some(Scale::PerAxis(s)) => Vec3::from(s),
+    };
+    let transform = Transform { position: Vec3::from(o.position), rotation_deg: Vec3::from(o.rotation_deg), scale };
+    let name = o.name.clone().unwrap_or_else(|| format!("{}{}", mesh.name, index + 1));
+    Ok(Object {
+        name,
+        mesh: Arc::new(mesh),
+        transform,
+        color: Vec3::from(o.color.unwrap_or(PALETTE[index % PALETTE.len()])),
+        casts: o.casts,
+        receives: o.receives,
+    })
+}

@@ -1,0 +1,213 @@
+//! Pure scene data: the TOML format of DESIGN.md §3, meshes and their edge adjacency.
+
+mod adjacency;
+mod file;
+mod mesh;
+pub mod primitives;
+
+use std::sync::Arc;
+
+use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
+
+pub use crate::geometry::Projection;
+use crate::error::{Error, Result};
+use crate::geometry::Aabb;
+pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
+pub use mesh::{Mesh, MeshId, Vertex};
+
+/// Where the camera is and how it projects.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub projection: Projection,
+}
+
+/// A spherical area light; radius 0 is a point light.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub position: Vec3,
+    pub radius: f32,
+    /// Where a spot frustum looks; `None`: the casters' centre.
+    pub target: Option<Vec3>,
+}
+
+/// The receiver plane y = `height`, normal +Y, a square of side 2 × `half_size`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    pub height: f32,
+    pub half_size: f32,
+}
+
+/// Position, rotation (right-handed Euler degrees, R = Rz·Ry·Rx) and scale.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    pub position: Vec3,
+    pub rotation_deg: Vec3,
+    pub scale: Vec3,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform { position: Vec3::ZERO, rotation_deg: Vec3::ZERO, scale: Vec3::ONE }
+    }
+}
+
+impl Transform {
+    pub fn matrix(&self) -> Mat4 {
+        let r = self.rotation_deg.map(f32::to_radians);
+        // X first, then Y, then Z: R = Rz·Ry·Rx.
+        let rotation = Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x);
+        Mat4::from_scale_rotation_translation(self.scale, rotation, self.position)
+    }
+}
+
+/// One mesh instance in the scene.
+#[derive(Clone, Debug)]
+pub struct Object {
+    pub name: String,
+    pub mesh: Arc<Mesh>,
+    pub transform: Transform,
+    /// Linear RGB albedo.
+    pub color: Vec3,
+    pub casts: bool,
+    pub receives: bool,
+}
+
+impl Object {
+    pub fn new(name: impl Into<String>, mesh: Arc<Mesh>) -> Self {
+        Object { name: name.into(), mesh, transform: Transform::default(), color: Vec3::splat(0.8), casts: true, receives: true }
+    }
+
+    /// World-space bounds of the transformed mesh.
+    pub fn bounds(&self) -> Aabb {
+        self.mesh.bounds.transformed(&self.transform.matrix())
+    }
+
+    /// The normal matrix (inverse transpose of the model's 3×3).
+    pub fn normal_matrix(&self) -> Mat3 {
+        Mat3::from_mat4(self.transform.matrix()).inverse().transpose()
+    }
+}
+
+/// Image size and technique as the scene file gives them; the command line may override.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub technique: String,
+    /// `[render.params]` as KEY, VALUE text, checked against the technique's knobs.
+    pub params: Vec<(String, String)>,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings { width: 512, height: 512, technique: "shadow-map".into(), params: Vec::new() }
+    }
+}
+
+/// Everything a frame shows: casters, receivers, one light, one camera.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub light: Light,
+    pub ground: Option<Ground>,
+    pub objects: Vec<Object>,
+    pub render: RenderSettings,
+}
+
+impl Scene {
+    /// Loads a scene file; meshes resolve relative to its folder.
+    pub fn load(path: impl AsRef<std::path::Path>) -> Result<Scene> {
+        file::load(path.as_ref())
+    }
+
+    /// Parses scene text; `path` names the file in messages and anchors mesh paths.
+    pub fn from_toml(text: &str, path: impl AsRef<std::path::Path>) -> Result<Scene> {
+        file::parse(text, path.as_ref())
+    }
+
+    /// Checks what a game loop may have changed since loading: every number finite, sizes
+    /// positive, the camera well defined, the light above the ground.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::Invalid(what));
+        let c = &self.camera;
+        for (name, v) in [("camera.position", c.position), ("camera.target", c.target), ("camera.up", c.up), ("light.position", self.light.position)] {
+            if !v.is_finite() {
+                return bad(format!("{name} is not finite: {v}"));
+            }
+        }
+        let forward = c.target - c.position;
+        if forward.length_squared() == 0.0 {
+            return bad("camera.position and camera.target coincide".into());
+        }
+        if c.up.length_squared() == 0.0 {
+            return bad("camera.up has zero length".into());
+        }
+        if forward.normalize().cross(c.up.normalize()).length() < 1e-4 {
+            return bad("camera.up is parallel to the view direction".into());
+        }
+        match c.projection {
+            Projection::Perspective { fov_y_deg } if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) => {
+                return bad(format!("camera.fov_y_deg must lie in (0, 180), got {fov_y_deg}"));
+            }
+            Projection::Orthographic { half_height } if !(half_height > 0.0 && half_height.is_finite()) => {
+                return bad(format!("camera.ortho_half_height must be positive, got {half_height}"));
+            }
+            _ => {}
+        }
+        let l = &self.light;
+        if !(l.radius >= 0.0 && l.radius.is_finite()) {
+            return bad(format!("light.radius must be zero or positive, got {}", l.radius));
+        }
+        if let Some(t) = l.target.filter(|t| !t.is_finite()) {
+            return bad(format!("light.target is not finite: {t}"));
+        }
+        if let Some(g) = &self.ground {
+            if !(g.height.is_finite() && g.half_size > 0.0 && g.half_size.is_finite()) {
+                return bad(format!("ground needs a finite height and a positive half_size, got {g:?}"));
+            }
+            if l.position.y - l.radius <= g.height {
+                return bad(format!(
+                    "the light (centre y = {}, radius {}) is inside the ground (y = {})",
+                    l.position.y, l.radius, g.height
+                ));
+            }
+        }
+        for (i, o) in self.objects.iter().enumerate() {
+            let t = &o.transform;
+            if !(t.position.is_finite() && t.rotation_deg.is_finite() && o.color.is_finite()) {
+                return bad(format!("object {i} ({}): position, rotation or color is not finite", o.name));
+            }
+            if !(t.scale.is_finite() && t.scale.cmpgt(Vec3::ZERO).all()) {
+                return bad(format!("object {i} ({}): scale must be positive, got {}", o.name, t.scale));
+            }
+        }
+        if self.render.width == 0 || self.render.height == 0 {
+            return bad(format!("render size {}x{} is empty", self.render.width, self.render.height));
+        }
+        Ok(())
+    }
+
+    /// Bounds of everything drawn: objects and the ground.
+    pub fn bounds(&self) -> Aabb {
+        let ground = self.ground.map(|g| g.bounds()).unwrap_or(Aabb::EMPTY);
+        self.objects.iter().fold(ground, |b, o| b.union(&o.bounds()))
+    }
+
+    /// The casters' centre: where the light looks unless told otherwise.
+    pub fn light_target(&self) -> Vec3 {
+        self.light.target.unwrap_or_else(|| {
+            let casters = Aabb::from_points(self.objects.iter().filter(|o| o.casts).flat_map(|o| o.bounds().corners()));
+            if casters.is_empty() { self.light.position - Vec3::Y } else { casters.center() }
+        })
+    }
+}
+
+impl Ground {
+    pub fn bounds(&self) -> Aabb {
+        let h = self.half_size;
+        Aabb { min: Vec3::new(-h, self.height, -h), max: Vec3::new(h, self.height, h) }
+    }
+}

@@ -1,0 +1,108 @@
+//! The techniques' names and knobs as data: what `softshadow techniques` lists, and what scene
+//! files and `--set KEY=VALUE` are checked against.
+
+use std::collections::BTreeMap;
+
+use crate::error::{Error, Result};
+
+/// One tunable number of a technique.
+#[derive(Clone, Copy, Debug)]
+pub struct Knob {
+    pub name: &'static str,
+    pub default: f64,
+    pub min: f64,
+    pub max: f64,
+    /// Only whole numbers are accepted.
+    pub integer: bool,
+    pub help: &'static str,
+}
+
+/// A technique as the command line and scene files see it.
+#[derive(Debug)]
+pub struct TechniqueInfo {
+    pub name: &'static str,
+    pub summary: &'static str,
+    pub knobs: &'static [Knob],
+}
+
+/// Every technique this build knows.
+pub const TECHNIQUES: &[&TechniqueInfo] = &[&crate::technique::shadow_map::INFO];
+
+/// Looks a technique up by name.
+pub fn find(name: &str) -> Result<&'static TechniqueInfo> {
+    TECHNIQUES.iter().copied().find(|t| t.name == name).ok_or_else(|| {
+        let names: Vec<_> = TECHNIQUES.iter().map(|t| t.name).collect();
+        Error::Invalid(format!("unknown technique `{name}` (known: {})", names.join(", ")))
+    })
+}
+
+/// Validated knob values of one technique; unset knobs take their defaults.
+#[derive(Clone, Debug)]
+pub struct Params {
+    pub technique: &'static TechniqueInfo,
+    values: BTreeMap<&'static str, f64>,
+}
+
+impl Params {
+    /// Every knob at its default.
+    pub fn defaults(technique: &'static TechniqueInfo) -> Self {
+        Params { technique, values: technique.knobs.iter().map(|k| (k.name, k.default)).collect() }
+    }
+
+    /// Sets `key` from text, checking that the knob exists and the value is in range.
+    pub fn set(&mut self, key: &str, value: &str) -> Result<()> {
+        let t = self.technique;
+        let knob = t.knobs.iter().find(|k| k.name == key).ok_or_else(|| {
+            let names: Vec<_> = t.knobs.iter().map(|k| k.name).collect();
+            Error::Invalid(format!("technique `{}` has no knob `{key}` (knobs: {})", t.name, names.join(", ")))
+        })?;
+        let v: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| Error::Invalid(format!("knob `{key}` of `{}`: `{value}` is not a number", t.name)))?;
+        if !v.is_finite() || v < knob.min || v > knob.max || (knob.integer && v.fract() != 0.0) {
+            let kind = if knob.integer { "a whole number" } else { "a number" };
+            return Err(Error::Invalid(format!(
+                "knob `{key}` of `{}`: {value} is out of range (want {kind} in {}..={})",
+                t.name, knob.min, knob.max
+            )));
+        }
+        self.values.insert(knob.name, v);
+        Ok(())
+    }
+
+    /// Applies `KEY=VALUE` pairs in order.
+    pub fn apply<'a>(&mut self, pairs: impl IntoIterator<Item = (&'a str, &'a str)>) -> Result<()> {
+        pairs.into_iter().try_for_each(|(k, v)| self.set(k, v))
+    }
+
+    /// The value of a knob this technique declares.
+    pub(crate) fn get(&self, name: &str) -> f64 {
+        self.values[name]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_lie_in_their_ranges() {
+        for t in TECHNIQUES {
+            for k in t.knobs {
+                assert!(k.min <= k.default && k.default <= k.max, "{}.{}", t.name, k.name);
+            }
+        }
+    }
+
+    #[test]
+    fn bad_knobs_are_named() {
+        let mut p = Params::defaults(find("shadow-map").unwrap());
+        let e = p.set("no_such", "1").unwrap_err().to_string();
+        assert!(e.contains("no_such") && e.contains("shadow_map_size"), "{e}");
+        let e = p.set("shadow_map_size", "1.5").unwrap_err().to_string();
+        assert!(e.contains("whole number"), "{e}");
+        assert!(p.set("shadow_map_size", "nan").is_err());
+        assert!(find("plateu").unwrap_err().to_string().contains("plateu"));
+    }
+}

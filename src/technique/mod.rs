@@ -1,0 +1,62 @@
+//! Techniques: each owns its targets, pipelines and passes, and writes the visibility image V.
+//! A technique builds only what the scene in front of it needs.
+
+pub mod knobs;
+pub mod shadow_map;
+
+use ash::vk;
+use glam::Vec3;
+
+use crate::error::Result;
+use crate::geometry::CameraProjection;
+use crate::gpu::{Context, PassTimer, Target};
+use crate::renderer::Draw;
+use crate::scene::Scene;
+pub use knobs::{Params, TECHNIQUES, TechniqueInfo};
+
+/// What a technique reads while it records one frame.
+pub struct FrameInputs<'a> {
+    pub ctx: &'a Context,
+    pub cmd: vk::CommandBuffer,
+    /// Frame-in-flight slot: selects per-frame buffers.
+    pub slot: usize,
+    pub timer: &'a mut PassTimer,
+    pub scene: &'a Scene,
+    pub camera: &'a CameraProjection,
+    /// `FrameGlobals` of this frame.
+    pub globals: vk::DescriptorBufferInfo,
+    /// `ObjectData` of every draw.
+    pub objects: vk::DescriptorBufferInfo,
+    pub draws: &'a [Draw],
+    /// Camera depth and normal, ready to be sampled.
+    pub depth: &'a Target,
+    pub normal: &'a Target,
+    /// Points whose hull is the receivers' visible part: no shadow matters outside it.
+    pub receivers_in_view: &'a [Vec3],
+}
+
+/// A shadowing technique: records its passes and leaves V written (as a color attachment).
+pub trait Technique {
+    fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()>;
+    fn destroy(self: Box<Self>, ctx: &Context);
+}
+
+/// Creates the technique `info` names.
+pub fn create(ctx: &Context, info: &TechniqueInfo) -> Result<Box<dyn Technique>> {
+    match info.name {
+        name if name == shadow_map::INFO.name => Ok(Box::new(shadow_map::ShadowMap::new(ctx)?)),
+        other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),
+    }
+}
+
+/// Writes V = 1 everywhere: the scene in view has nothing that can shadow a receiver, so no
+/// technique targets or passes are needed this frame.
+pub(crate) fn clear_visibility(frame: &mut FrameInputs<'_>, visibility: &mut Target) -> Result<()> {
+    use crate::gpu::{Access, Attachment, RenderPass, transition};
+    let (ctx, cmd) = (frame.ctx, frame.cmd);
+    frame.timer.begin(ctx, cmd, "resolve");
+    transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
+    RenderPass::begin(ctx, cmd, &[Attachment::clear_color(visibility, [1.0; 4])], None).end(ctx, cmd);
+    frame.timer.end(ctx, cmd);
+    Ok(())
+}
