@@ -49,10 +49,7 @@ fn main() {
             for candidate in candidates {
                 if let Ok(content) = fs::read_to_string(&candidate) {
                     println!("cargo:rerun-if-changed={}", candidate.display());
-                    return Ok(shaderc::ResolvedInclude {
-                        resolved_name: candidate.display().to_string(),
-                        content,
-                    });
+                    return Ok(shaderc::ResolvedInclude { resolved_name: candidate.display().to_string(), content });
                 }
             }
             Err(format!("#include \"{name}\" not found beside {includer} nor in glsl/common"))
@@ -99,8 +96,5 @@ fn rel(root: &Path, path: &Path) -> String {
 }
 
 fn const_name(glsl: &Path, path: &Path) -> String {
-    rel(glsl, path)
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' })
-        .collect()
+    rel(glsl, path).chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_uppercase() } else { '_' }).collect()
 }

@@ -8,9 +8,7 @@ use std::process::Command;
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    let out = Command::new("pkg-config")
-        .args(["--libs", "--static", "glslang", "SPIRV-Tools"])
-        .output();
+    let out = Command::new("pkg-config").args(["--libs", "--static", "glslang", "SPIRV-Tools"]).output();
     let libs = match out {
         Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout).into_owned(),
         _ => panic!(

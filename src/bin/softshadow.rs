@@ -109,7 +109,10 @@ fn default_run() -> Result<()> {
         frames: 20,
     };
     let report = render(&args)?;
-    println!("{} on {} ({}), {}x{}, median of {} frames", report.technique, report.device, report.driver, report.width, report.height, report.frames);
+    println!(
+        "{} on {} ({}), {}x{}, median of {} frames",
+        report.technique, report.device, report.driver, report.width, report.height, report.frames
+    );
     println!("{:<12} {:>10} {:>10}", "pass", "GPU ms", "p95 ms");
     for p in &report.passes {
         println!("{:<12} {:>10.3} {:>10.3}", p.name, p.gpu_ms_median, p.gpu_ms_p95);

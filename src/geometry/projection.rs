@@ -117,7 +117,14 @@ mod tests {
 
     #[test]
     fn reverse_z_covers_the_scene() {
-        let cam = CameraProjection::new(Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene());
+        let cam = CameraProjection::new(
+            Vec3::new(3.0, 4.0, 5.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            Projection::Perspective { fov_y_deg: 60.0 },
+            1.5,
+            &scene(),
+        );
         let near = ndc(&cam.view_proj, Vec3::splat(1.0)).z;
         let far = ndc(&cam.view_proj, Vec3::splat(-1.0)).z;
         assert!(near > far && (0.0..=1.0).contains(&near) && (0.0..=1.0).contains(&far));

@@ -17,8 +17,11 @@ pub struct Access {
 
 impl Access {
     /// Not touched yet.
-    pub const NONE: Access =
-        Access { stage: vk::PipelineStageFlags2::NONE, access: vk::AccessFlags2::NONE, layout: vk::ImageLayout::UNDEFINED };
+    pub const NONE: Access = Access {
+        stage: vk::PipelineStageFlags2::NONE,
+        access: vk::AccessFlags2::NONE,
+        layout: vk::ImageLayout::UNDEFINED,
+    };
     /// Written as a color attachment.
     pub const COLOR_WRITE: Access = Access {
         stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
@@ -28,10 +31,12 @@ impl Access {
     /// Tested and written as a depth attachment.
     pub const DEPTH_WRITE: Access = Access {
         stage: vk::PipelineStageFlags2::from_raw(
-            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+            vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw()
+                | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
         ),
         access: vk::AccessFlags2::from_raw(
-            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw() | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+            vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw()
+                | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
         ),
         layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
     };
@@ -97,6 +102,8 @@ pub fn copy_to_host(ctx: &Context, cmd: vk::CommandBuffer) {
 
 fn is_write(access: vk::AccessFlags2) -> bool {
     access.intersects(
-        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags2::TRANSFER_WRITE,
+        vk::AccessFlags2::COLOR_ATTACHMENT_WRITE
+            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
+            | vk::AccessFlags2::TRANSFER_WRITE,
     )
 }

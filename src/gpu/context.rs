@@ -76,7 +76,8 @@ impl Context {
             .map_err(|e| Error::NoDevice(format!("no Vulkan loader ({e}): {INSTALL_HINT}")))?;
         let log = Box::<ValidationLog>::default();
 
-        let available_ext = unsafe { entry.enumerate_instance_extension_properties(None) }.vk("vkEnumerateInstanceExtensionProperties")?;
+        let available_ext = unsafe { entry.enumerate_instance_extension_properties(None) }
+            .vk("vkEnumerateInstanceExtensionProperties")?;
         let has_ext = |name: &CStr| available_ext.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
         let debug_utils = has_ext(ash::ext::debug_utils::NAME);
         let mut extensions: Vec<*const c_char> = Vec::new();
@@ -134,11 +135,13 @@ impl Context {
             .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS) && q.timestamp_valid_bits > 0)
             .ok_or_else(|| Error::NoDevice(format!("{}: no graphics queue with timestamps", name_of(&props))))?
             as u32;
-        let timestamp_valid_bits =
-            unsafe { instance.get_physical_device_queue_family_properties(physical) }[queue_family as usize].timestamp_valid_bits;
+        let timestamp_valid_bits = unsafe { instance.get_physical_device_queue_family_properties(physical) }
+            [queue_family as usize]
+            .timestamp_valid_bits;
 
         let priorities = [1.0];
-        let queue_ci = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
+        let queue_ci =
+            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let device_ext = [ash::khr::push_descriptor::NAME.as_ptr()];
         let mut v13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
         let device_ci = vk::DeviceCreateInfo::default()
@@ -186,7 +189,12 @@ impl Context {
             name: name_of(&props),
             driver: driver_of(instance, physical),
             device_type: format!("{:?}", props.device_type),
-            vulkan_version: format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v)),
+            vulkan_version: format!(
+                "{}.{}.{}",
+                vk::api_version_major(v),
+                vk::api_version_minor(v),
+                vk::api_version_patch(v)
+            ),
             max_image_dimension_2d: limits.max_image_dimension2_d,
             max_push_constants_size: limits.max_push_constants_size,
             timestamp_period_ns: limits.timestamp_period,
@@ -321,7 +329,10 @@ fn driver_of(instance: &ash::Instance, physical: vk::PhysicalDevice) -> String {
 }
 
 /// A real GPU when present, lavapipe otherwise; `wanted` (a name substring) overrides.
-fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::PhysicalDevice, vk::PhysicalDeviceProperties)> {
+fn pick_device(
+    instance: &ash::Instance,
+    wanted: Option<&str>,
+) -> Result<(vk::PhysicalDevice, vk::PhysicalDeviceProperties)> {
     let devices = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     let usable: Vec<_> = devices
         .into_iter()
@@ -350,4 +361,31 @@ fn pick_device(instance: &ash::Instance, wanted: Option<&str>) -> Result<(vk::Ph
         _ => 4,
     };
     Ok(*usable.iter().min_by_key(|(_, p)| rank(p.device_type)).expect("non-empty"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The zero-errors assertions of every GPU test rest on this: an invalid call is recorded.
+    #[test]
+    fn validation_errors_are_recorded() {
+        let mut ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
+        assert!(ctx.validation_errors().is_empty());
+        // VUID-VkBufferCreateInfo-size-00912: size must be greater than 0.
+        let ci = vk::BufferCreateInfo::default().size(0).usage(vk::BufferUsageFlags::UNIFORM_BUFFER);
+        if let Ok(buffer) = unsafe { ctx.device.create_buffer(&ci, None) } {
+            unsafe { ctx.device.destroy_buffer(buffer, None) };
+        }
+        ctx.destroy();
+        let errors = ctx.validation_errors();
+        assert!(errors.iter().any(|e| e.contains("00912")), "{errors:?}");
+    }
+
+    #[test]
+    fn a_device_name_that_matches_nothing_is_an_error() {
+        let options = ContextOptions { validation: false, device: Some("no such gpu 9000".into()) };
+        let err = Context::headless(&options).err().expect("no device matches").to_string();
+        assert!(err.contains("no such gpu 9000") && err.contains("have:"), "{err}");
+    }
 }

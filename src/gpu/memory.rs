@@ -16,12 +16,24 @@ pub struct Buffer {
 
 impl Buffer {
     /// `location`: `CpuToGpu` for per-frame data, `GpuToCpu` for readback, `GpuOnly` otherwise.
-    pub fn new(ctx: &Context, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Self> {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Self> {
         let size = size.max(4);
         let ci = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         let buffer = unsafe { ctx.device.create_buffer(&ci, None) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(buffer) };
-        let desc = AllocationCreateDesc { name, requirements, location, linear: true, allocation_scheme: AllocationScheme::GpuAllocatorManaged };
+        let desc = AllocationCreateDesc {
+            name,
+            requirements,
+            location,
+            linear: true,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        };
         let allocation = match ctx.allocate(&desc) {
             Ok(a) => a,
             Err(e) => {
@@ -66,7 +78,13 @@ pub struct PerFrame {
 }
 
 impl PerFrame {
-    pub fn new(ctx: &Context, name: &str, bytes_per_frame: u64, frames: usize, usage: vk::BufferUsageFlags) -> Result<Self> {
+    pub fn new(
+        ctx: &Context,
+        name: &str,
+        bytes_per_frame: u64,
+        frames: usize,
+        usage: vk::BufferUsageFlags,
+    ) -> Result<Self> {
         let limits = &ctx.limits;
         let align = limits.min_uniform_buffer_offset_alignment.max(limits.min_storage_buffer_offset_alignment).max(16);
         let stride = bytes_per_frame.max(16).div_ceil(align) * align;

@@ -124,24 +124,38 @@ impl Pipeline {
         };
         let stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(frag).name(c"main"),
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::FRAGMENT)
+                .module(frag)
+                .name(c"main"),
         ];
         let stride = std::mem::size_of::<crate::scene::Vertex>() as u32;
         let vb = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
         let attrs = [
-            vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
-            vk::VertexInputAttributeDescription { location: 1, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
+            vk::VertexInputAttributeDescription {
+                location: 0,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 1,
+                binding: 0,
+                format: vk::Format::R32G32B32_SFLOAT,
+                offset: 12,
+            },
         ];
         let vertex_input = match desc.vertex_input {
             VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
-            VertexInput::Position => {
-                vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&vb).vertex_attribute_descriptions(&attrs[..1])
-            }
-            VertexInput::PositionNormal => {
-                vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&vb).vertex_attribute_descriptions(&attrs)
-            }
+            VertexInput::Position => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vb)
+                .vertex_attribute_descriptions(&attrs[..1]),
+            VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&vb)
+                .vertex_attribute_descriptions(&attrs),
         };
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let assembly =
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         // Two-sided everywhere: plates and open meshes have no inside to cull.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
@@ -149,7 +163,8 @@ impl Pipeline {
             .cull_mode(vk::CullModeFlags::NONE)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample =
+            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth.is_some())
             .depth_write_enable(desc.depth.is_some())
@@ -199,7 +214,11 @@ impl Pipeline {
         let images: Vec<[vk::DescriptorImageInfo; 1]> = inputs
             .iter()
             .map(|i| match i {
-                Descriptor::Image(t) => [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: t.view, image_layout: t.last.layout }],
+                Descriptor::Image(t) => [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: t.view,
+                    image_layout: t.last.layout,
+                }],
                 Descriptor::Buffer(_) => [vk::DescriptorImageInfo::default()],
             })
             .collect();

@@ -39,7 +39,12 @@ pub struct RenderPass;
 impl RenderPass {
     /// Begins rendering into `colors` and `depth` (all the same size, already transitioned) and
     /// sets the viewport and scissor to cover them.
-    pub fn begin(ctx: &Context, cmd: vk::CommandBuffer, colors: &[Attachment<'_>], depth: Option<Attachment<'_>>) -> Self {
+    pub fn begin(
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        colors: &[Attachment<'_>],
+        depth: Option<Attachment<'_>>,
+    ) -> Self {
         let extent = colors.first().or(depth.as_ref()).expect("a pass draws into something").target.extent();
         let color_infos: Vec<_> = colors.iter().map(Attachment::info).collect();
         let depth_info = depth.as_ref().map(Attachment::info);

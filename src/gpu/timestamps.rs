@@ -81,7 +81,10 @@ impl PassTimer {
             self.names
                 .iter()
                 .zip(raw.chunks_exact(2))
-                .map(|(&name, t)| PassTime { name, ms: ((t[1] & mask).wrapping_sub(t[0] & mask) & mask) as f64 * period * 1e-6 })
+                .map(|(&name, t)| PassTime {
+                    name,
+                    ms: ((t[1] & mask).wrapping_sub(t[0] & mask) & mask) as f64 * period * 1e-6,
+                })
                 .collect(),
         ))
     }

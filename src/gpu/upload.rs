@@ -20,7 +20,12 @@ pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFla
         }
     };
     let result = submit_and_wait(ctx, |cmd| unsafe {
-        ctx.device.cmd_copy_buffer(cmd, staging.buffer, dst.buffer, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size }]);
+        ctx.device.cmd_copy_buffer(
+            cmd,
+            staging.buffer,
+            dst.buffer,
+            &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size }],
+        );
         // Later frames read the data as vertices and indices: order them after the copy.
         let barrier = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
@@ -46,7 +51,10 @@ fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Res
         .flags(vk::CommandPoolCreateFlags::TRANSIENT);
     let pool = unsafe { d.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
     let run = || -> Result<()> {
-        let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).level(vk::CommandBufferLevel::PRIMARY).command_buffer_count(1);
+        let alloc = vk::CommandBufferAllocateInfo::default()
+            .command_pool(pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(1);
         let cmd = unsafe { d.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
         let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         unsafe { d.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;

@@ -31,7 +31,13 @@ pub struct TimingReport {
 
 impl TimingReport {
     /// Summarises `frames` (warm-up already dropped); passes keep their recording order.
-    pub fn new(device: &crate::gpu::DeviceInfo, technique: &str, width: u32, height: u32, frames: &[FrameTimings]) -> Self {
+    pub fn new(
+        device: &crate::gpu::DeviceInfo,
+        technique: &str,
+        width: u32,
+        height: u32,
+        frames: &[FrameTimings],
+    ) -> Self {
         let mut names: Vec<&'static str> = Vec::new();
         for f in frames {
             for p in &f.passes {
@@ -43,8 +49,13 @@ impl TimingReport {
         let passes = names
             .iter()
             .map(|&name| {
-                let ms: Vec<f64> = frames.iter().flat_map(|f| f.passes.iter().filter(|p| p.name == name).map(|p| p.ms)).collect();
-                PassSummary { name: name.to_string(), gpu_ms_median: percentile(&ms, 0.5), gpu_ms_p95: percentile(&ms, 0.95) }
+                let ms: Vec<f64> =
+                    frames.iter().flat_map(|f| f.passes.iter().filter(|p| p.name == name).map(|p| p.ms)).collect();
+                PassSummary {
+                    name: name.to_string(),
+                    gpu_ms_median: percentile(&ms, 0.5),
+                    gpu_ms_p95: percentile(&ms, 0.95),
+                }
             })
             .collect();
         let totals: Vec<f64> = frames.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect();

@@ -19,14 +19,31 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
         buffer_offset: offset,
         buffer_row_length: 0,
         buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 },
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
         image_offset: vk::Offset3D::default(),
         image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
     };
     let color_bytes = extent.width as u64 * extent.height as u64 * 4;
     unsafe {
-        ctx.device.cmd_copy_image_to_buffer(cmd, t.color.image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.buffer, &[region(0)]);
-        ctx.device.cmd_copy_image_to_buffer(cmd, t.visibility.image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, dst.buffer, &[region(color_bytes)]);
+        ctx.device.cmd_copy_image_to_buffer(
+            cmd,
+            t.color.image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            dst.buffer,
+            &[region(0)],
+        );
+        ctx.device.cmd_copy_image_to_buffer(
+            cmd,
+            t.visibility.image,
+            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+            dst.buffer,
+            &[region(color_bytes)],
+        );
     }
 }
 

@@ -52,7 +52,15 @@ pub struct MeshCache {
 
 impl MeshCache {
     /// A draw of `mesh` in frame `frame`, uploading it on first sight.
-    pub fn draw(&mut self, ctx: &Context, mesh: &Arc<Mesh>, frame: u64, instance: u32, bounds: Aabb, flags: (bool, bool)) -> Result<Draw> {
+    pub fn draw(
+        &mut self,
+        ctx: &Context,
+        mesh: &Arc<Mesh>,
+        frame: u64,
+        instance: u32,
+        bounds: Aabb,
+        flags: (bool, bool),
+    ) -> Result<Draw> {
         let gpu = match self.meshes.entry(mesh.id()) {
             std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::hash_map::Entry::Vacant(e) => {
@@ -82,7 +90,8 @@ impl MeshCache {
 
     /// Destroys meshes that no frame after `completed` uses (frames up to it have finished).
     pub fn evict(&mut self, ctx: &Context, completed: u64) {
-        let stale: Vec<MeshId> = self.meshes.iter().filter(|(_, m)| m.last_used <= completed).map(|(id, _)| *id).collect();
+        let stale: Vec<MeshId> =
+            self.meshes.iter().filter(|(_, m)| m.last_used <= completed).map(|(id, _)| *id).collect();
         for id in stale {
             if let Some(m) = self.meshes.remove(&id) {
                 m.vertices.destroy(ctx);

@@ -22,8 +22,8 @@ use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass};
 use crate::error::Result;
 use crate::geometry::{Aabb, CameraProjection, Hexahedron, intersection_points};
 use crate::gpu::{
-    Access, Buffer, Context, ContextOptions, DeviceInfo, FRAMES_IN_FLIGHT, FrameRing, PassTime, PerFrame, Target, TargetDesc,
-    copy_to_host, transition,
+    Access, Buffer, Context, ContextOptions, DeviceInfo, FRAMES_IN_FLIGHT, FrameRing, PassTime, PerFrame, Target,
+    TargetDesc, copy_to_host, transition,
 };
 use crate::gpu_types::{FrameGlobals, ObjectData};
 use crate::scene::{Ground, Mesh, Scene, primitives};
@@ -151,7 +151,8 @@ impl Engine {
         engine.prepass = Some(Prepass::new(ctx)?);
         engine.composite = Some(Composite::new(ctx)?);
         let size = std::mem::size_of::<FrameGlobals>() as u64;
-        engine.globals = Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
+        engine.globals =
+            Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
         Ok(engine)
     }
 
@@ -243,7 +244,8 @@ impl Engine {
                 old.destroy(ctx);
             }
             let size = (bytes.len() as u64).next_power_of_two();
-            self.objects = Some(PerFrame::new(ctx, "objects", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::STORAGE_BUFFER)?);
+            self.objects =
+                Some(PerFrame::new(ctx, "objects", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         }
         let object_buffer = self.objects.as_mut().expect("ensured");
         if !bytes.is_empty() {
@@ -299,7 +301,14 @@ impl Engine {
                 self.readback = Some(Buffer::new(ctx, "readback", size, usage, MemoryLocation::GpuToCpu)?);
             }
             let readback = self.readback.as_ref().expect("ensured");
-            transition(ctx, frame.cmd, &mut [(&mut targets.color, Access::COPY_READ, false), (&mut targets.visibility, Access::COPY_READ, false)]);
+            transition(
+                ctx,
+                frame.cmd,
+                &mut [
+                    (&mut targets.color, Access::COPY_READ, false),
+                    (&mut targets.visibility, Access::COPY_READ, false),
+                ],
+            );
             capture::record_copies(ctx, frame.cmd, targets, readback);
             copy_to_host(ctx, frame.cmd);
         }
@@ -371,7 +380,11 @@ fn object_data(model: Mat4, normal: Mat4, color: Vec3, receives: bool) -> Object
 /// The ground is the unit plate scaled to the ground's square, at its height.
 fn ground_model(g: &Ground) -> Mat4 {
     let side = 2.0 * g.half_size;
-    Mat4::from_scale_rotation_translation(Vec3::new(side, 1.0, side), glam::Quat::IDENTITY, Vec3::new(0.0, g.height, 0.0))
+    Mat4::from_scale_rotation_translation(
+        Vec3::new(side, 1.0, side),
+        glam::Quat::IDENTITY,
+        Vec3::new(0.0, g.height, 0.0),
+    )
 }
 
 /// Points spanning the visible part of every receiver: each receiver's box clipped by the

@@ -5,8 +5,8 @@ use ash::vk;
 use super::{CameraTargets, Draw};
 use crate::error::Result;
 use crate::gpu::{
-    Access, Attachment, Binding, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass, VertexInput,
-    draw_fullscreen, shaders, transition,
+    Access, Attachment, Binding, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass,
+    VertexInput, draw_fullscreen, shaders, transition,
 };
 
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -38,13 +38,24 @@ impl Prepass {
     }
 
     /// Draws everything; leaves depth and normal ready for the technique and the composite.
-    pub fn record(&self, ctx: &Context, frame: &mut Frame<'_>, t: &mut CameraTargets, inputs: [vk::DescriptorBufferInfo; 2], draws: &[Draw]) {
+    pub fn record(
+        &self,
+        ctx: &Context,
+        frame: &mut Frame<'_>,
+        t: &mut CameraTargets,
+        inputs: [vk::DescriptorBufferInfo; 2],
+        draws: &[Draw],
+    ) {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "prepass");
         transition(
             ctx,
             cmd,
-            &mut [(&mut t.depth, Access::DEPTH_WRITE, true), (&mut t.normal, Access::COLOR_WRITE, true), (&mut t.albedo, Access::COLOR_WRITE, true)],
+            &mut [
+                (&mut t.depth, Access::DEPTH_WRITE, true),
+                (&mut t.normal, Access::COLOR_WRITE, true),
+                (&mut t.albedo, Access::COLOR_WRITE, true),
+            ],
         );
         let pass = RenderPass::begin(
             ctx,
@@ -88,7 +99,13 @@ impl Composite {
                 name: "composite",
                 vertex: shaders::COMMON_FULLSCREEN_VERT,
                 fragment: shaders::COMPOSITE_COMPOSITE_FRAG,
-                bindings: &[(Binding::Uniform, f), (Binding::Sampled, f), (Binding::Sampled, f), (Binding::Sampled, f), (Binding::Sampled, f)],
+                bindings: &[
+                    (Binding::Uniform, f),
+                    (Binding::Sampled, f),
+                    (Binding::Sampled, f),
+                    (Binding::Sampled, f),
+                    (Binding::Sampled, f),
+                ],
                 vertex_input: VertexInput::None,
                 color_formats: &[COLOR_FORMAT],
                 depth: None,
@@ -97,10 +114,20 @@ impl Composite {
         Ok(Composite { pipeline })
     }
 
-    pub fn record(&self, ctx: &Context, frame: &mut Frame<'_>, t: &mut CameraTargets, globals: vk::DescriptorBufferInfo) {
+    pub fn record(
+        &self,
+        ctx: &Context,
+        frame: &mut Frame<'_>,
+        t: &mut CameraTargets,
+        globals: vk::DescriptorBufferInfo,
+    ) {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "composite");
-        transition(ctx, cmd, &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (&mut t.color, Access::COLOR_WRITE, true)]);
+        transition(
+            ctx,
+            cmd,
+            &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (&mut t.color, Access::COLOR_WRITE, true)],
+        );
         let pass = RenderPass::begin(ctx, cmd, &[Attachment { target: &t.color, clear: None }], None);
         self.pipeline.bind(
             ctx,

@@ -39,7 +39,8 @@ impl EdgeAdjacency {
     /// Builds the adjacency of `triangles` (indices into a welded vertex list).
     pub fn build(triangles: &[[u32; 3]]) -> Self {
         // Key: the edge's vertices sorted; value: (face, vertices in that face's winding).
-        let mut by_edge: HashMap<(u32, u32), Vec<(u32, [u32; 2])>> = HashMap::with_capacity(triangles.len() * 3 / 2);
+        type FaceUses = Vec<(u32, [u32; 2])>;
+        let mut by_edge: HashMap<(u32, u32), FaceUses> = HashMap::with_capacity(triangles.len() * 3 / 2);
         for (face, tri) in triangles.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -62,9 +63,7 @@ impl EdgeAdjacency {
                 }
                 many => {
                     adjacency.non_manifold += 1;
-                    adjacency
-                        .edges
-                        .extend(many.iter().map(|(f, v)| Edge { vertices: *v, faces: [*f, NO_FACE] }));
+                    adjacency.edges.extend(many.iter().map(|(f, v)| Edge { vertices: *v, faces: [*f, NO_FACE] }));
                 }
             }
         }

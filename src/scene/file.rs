@@ -108,11 +108,18 @@ struct RenderFile {
 }
 
 /// Albedos for objects that name no color: distinct, mid-bright, linear RGB.
-const PALETTE: [[f32; 3]; 6] =
-    [[0.80, 0.30, 0.25], [0.25, 0.50, 0.80], [0.85, 0.70, 0.25], [0.35, 0.70, 0.40], [0.65, 0.40, 0.75], [0.80, 0.80, 0.80]];
+const PALETTE: [[f32; 3]; 6] = [
+    [0.80, 0.30, 0.25],
+    [0.25, 0.50, 0.80],
+    [0.85, 0.70, 0.25],
+    [0.35, 0.70, 0.40],
+    [0.65, 0.40, 0.75],
+    [0.80, 0.80, 0.80],
+];
 
 pub(super) fn load(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::scene(path, format!("cannot read the scene file: {e}")))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::scene(path, format!("cannot read the scene file: {e}")))?;
     parse(&text, path)
 }
 
@@ -166,7 +173,9 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
                 toml::Value::Integer(n) => Ok((k.clone(), n.to_string())),
                 toml::Value::Float(x) => Ok((k.clone(), x.to_string())),
                 toml::Value::String(s) => Ok((k.clone(), s.clone())),
-                other => Err(err(format!("[render.params] `{k}` must be a number or a string, got {}", other.type_str()))),
+                other => {
+                    Err(err(format!("[render.params] `{k}` must be a number or a string, got {}", other.type_str())))
+                }
             })
             .collect::<Result<_>>()?,
     };

@@ -119,7 +119,8 @@ impl Mesh {
                 let normal = sum.try_normalize().or(own.try_normalize()).unwrap_or(Vec3::Y);
                 let key = (v, normal.to_array().map(f32::to_bits));
                 let index = *lookup.entry(key).or_insert_with(|| {
-                    vertices.push(Vertex { position: self.positions[v as usize].to_array(), normal: normal.to_array() });
+                    vertices
+                        .push(Vertex { position: self.positions[v as usize].to_array(), normal: normal.to_array() });
                     vertices.len() as u32 - 1
                 });
                 indices.push(index);

@@ -9,9 +9,9 @@ use std::sync::Arc;
 
 use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
 
-pub use crate::geometry::Projection;
 use crate::error::{Error, Result};
 use crate::geometry::Aabb;
+pub use crate::geometry::Projection;
 pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
 pub use mesh::{Mesh, MeshId, Vertex};
 
@@ -77,7 +77,14 @@ pub struct Object {
 
 impl Object {
     pub fn new(name: impl Into<String>, mesh: Arc<Mesh>) -> Self {
-        Object { name: name.into(), mesh, transform: Transform::default(), color: Vec3::splat(0.8), casts: true, receives: true }
+        Object {
+            name: name.into(),
+            mesh,
+            transform: Transform::default(),
+            color: Vec3::splat(0.8),
+            casts: true,
+            receives: true,
+        }
     }
 
     /// World-space bounds of the transformed mesh.
@@ -133,7 +140,12 @@ impl Scene {
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::Invalid(what));
         let c = &self.camera;
-        for (name, v) in [("camera.position", c.position), ("camera.target", c.target), ("camera.up", c.up), ("light.position", self.light.position)] {
+        for (name, v) in [
+            ("camera.position", c.position),
+            ("camera.target", c.target),
+            ("camera.up", c.up),
+            ("light.position", self.light.position),
+        ] {
             if !v.is_finite() {
                 return bad(format!("{name} is not finite: {v}"));
             }

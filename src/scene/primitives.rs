@@ -16,13 +16,24 @@ const SPHERE_RINGS: u32 = 16;
 pub fn cuboid(size: Vec3) -> Result<Mesh> {
     let h = size * 0.5;
     if size.y == 0.0 {
-        let p = vec![Vec3::new(-h.x, 0.0, -h.z), Vec3::new(h.x, 0.0, -h.z), Vec3::new(h.x, 0.0, h.z), Vec3::new(-h.x, 0.0, h.z)];
+        let p = vec![
+            Vec3::new(-h.x, 0.0, -h.z),
+            Vec3::new(h.x, 0.0, -h.z),
+            Vec3::new(h.x, 0.0, h.z),
+            Vec3::new(-h.x, 0.0, h.z),
+        ];
         // Top faces +Y; the bottom uses the other diagonal so no edge joins four faces.
         let tris = vec![[0, 2, 1], [0, 3, 2], [0, 1, 3], [1, 2, 3]];
         return Mesh::new("plate", p, tris);
     }
     let p: Vec<Vec3> = (0..8)
-        .map(|i| Vec3::new(if i & 1 == 0 { -h.x } else { h.x }, if i & 2 == 0 { -h.y } else { h.y }, if i & 4 == 0 { -h.z } else { h.z }))
+        .map(|i| {
+            Vec3::new(
+                if i & 1 == 0 { -h.x } else { h.x },
+                if i & 2 == 0 { -h.y } else { h.y },
+                if i & 4 == 0 { -h.z } else { h.z },
+            )
+        })
         .collect();
     // Each face as a quad listed counter-clockwise from outside.
     let quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];

@@ -26,15 +26,42 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "hard shadows from the light's centre: one shadow map, 2x2 bilinear comparison",
     knobs: &[
         SHADOW_MAP_SIZE,
-        Knob { name: "depth_bias", default: 1.0, min: 0.0, max: 64.0, integer: false, help: "constant depth bias, in shadow-map texels" },
-        Knob { name: "slope_bias", default: 1.0, min: 0.0, max: 64.0, integer: false, help: "depth bias per unit tan(angle to the light), in texels" },
-        Knob { name: "normal_offset", default: 1.5, min: 0.0, max: 64.0, integer: false, help: "lookup offset along the normal at grazing angles, in texels" },
+        Knob {
+            name: "depth_bias",
+            default: 1.0,
+            min: 0.0,
+            max: 64.0,
+            integer: false,
+            help: "constant depth bias, in shadow-map texels",
+        },
+        Knob {
+            name: "slope_bias",
+            default: 1.0,
+            min: 0.0,
+            max: 64.0,
+            integer: false,
+            help: "depth bias per unit tan(angle to the light), in texels",
+        },
+        Knob {
+            name: "normal_offset",
+            default: 1.5,
+            min: 0.0,
+            max: 64.0,
+            integer: false,
+            help: "lookup offset along the normal at grazing angles, in texels",
+        },
     ],
 };
 
 /// Shared by every technique that renders a shadow map.
-pub const SHADOW_MAP_SIZE: Knob =
-    Knob { name: "shadow_map_size", default: 2048.0, min: 16.0, max: 16384.0, integer: true, help: "shadow map width and height, in texels" };
+pub const SHADOW_MAP_SIZE: Knob = Knob {
+    name: "shadow_map_size",
+    default: 2048.0,
+    min: 16.0,
+    max: 16384.0,
+    integer: true,
+    help: "shadow map width and height, in texels",
+};
 
 /// Linear depth cleared beyond any caster: "nothing blocks this texel".
 const EMPTY_DEPTH: f32 = f32::MAX;
@@ -55,20 +82,24 @@ impl ShadowMapPass {
                 name: "shadow_map",
                 vertex: shaders::SHADOW_MAP_DEPTH_VERT,
                 fragment: shaders::SHADOW_MAP_DEPTH_FRAG,
-                bindings: &[(Binding::Uniform, vk::ShaderStageFlags::VERTEX), (Binding::Storage, vk::ShaderStageFlags::VERTEX)],
+                bindings: &[
+                    (Binding::Uniform, vk::ShaderStageFlags::VERTEX),
+                    (Binding::Storage, vk::ShaderStageFlags::VERTEX),
+                ],
                 vertex_input: VertexInput::Position,
                 color_formats: &[vk::Format::R32_SFLOAT],
                 depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
             },
         )?;
         let usage = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let light = match PerFrame::new(ctx, "light view", std::mem::size_of::<LightView>() as u64, FRAMES_IN_FLIGHT, usage) {
-            Ok(l) => l,
-            Err(e) => {
-                pipeline.destroy(ctx);
-                return Err(e);
-            }
-        };
+        let light =
+            match PerFrame::new(ctx, "light view", std::mem::size_of::<LightView>() as u64, FRAMES_IN_FLIGHT, usage) {
+                Ok(l) => l,
+                Err(e) => {
+                    pipeline.destroy(ctx);
+                    return Err(e);
+                }
+            };
         Ok(ShadowMapPass { pipeline, light, map: None, depth: None })
     }
 
@@ -80,7 +111,13 @@ impl ShadowMapPass {
     }
 
     /// Records the map; afterwards it is ready to be sampled by fragment shaders.
-    pub fn record(&mut self, frame: &mut FrameInputs<'_>, frustum: &LightFrustum, size: u32, bias: [f32; 3]) -> Result<()> {
+    pub fn record(
+        &mut self,
+        frame: &mut FrameInputs<'_>,
+        frustum: &LightFrustum,
+        size: u32,
+        bias: [f32; 3],
+    ) -> Result<()> {
         let ctx = frame.ctx;
         ensure(ctx, &mut self.map, TargetDesc::color("shadow map", vk::Format::R32_SFLOAT, size, size))?;
         ensure(ctx, &mut self.depth, TargetDesc::depth("shadow map depth", size, size))?;
@@ -102,7 +139,11 @@ impl ShadowMapPass {
             &[Attachment::clear_color(map, [EMPTY_DEPTH; 4])],
             Some(Attachment::clear_depth(depth, 1.0)),
         );
-        self.pipeline.bind(ctx, cmd, &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)]);
+        self.pipeline.bind(
+            ctx,
+            cmd,
+            &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
+        );
         for draw in frame.draws.iter().filter(|d| d.casts) {
             draw.record(ctx, cmd);
         }

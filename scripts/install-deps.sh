@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# System packages for building and testing softshadow on Debian 12: the Vulkan loader, Mesa's
+# lavapipe (a CPU Vulkan driver), the Khronos validation layers, and the shader compiler
+# (libshaderc-dev with the glslang and SPIRV-Tools archives it links against).
+set -euo pipefail
+packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers
+          libshaderc-dev glslang-dev spirv-tools pkg-config)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

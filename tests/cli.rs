@@ -1,0 +1,87 @@
+//! The command line: render writes the images and a timings file in the format of DESIGN.md §3.
+
+use std::process::Command;
+
+fn softshadow() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_softshadow"));
+    c.env("SOFTSHADOW_VALIDATION", "1").current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+#[test]
+fn render_writes_images_and_timings() {
+    let dir = std::env::temp_dir().join(format!("softshadow-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (color, vis, timings) = (dir.join("c.png"), dir.join("v.png"), dir.join("t.json"));
+    let out = softshadow()
+        .args([
+            "render",
+            "scenes/default.toml",
+            "--width",
+            "96",
+            "--height",
+            "64",
+            "--frames",
+            "3",
+            "--set",
+            "shadow_map_size=256",
+        ])
+        .arg("--out")
+        .arg(&color)
+        .arg("--visibility")
+        .arg(&vis)
+        .arg("--timings")
+        .arg(&timings)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+
+    let t: serde_json::Value = serde_json::from_slice(&std::fs::read(&timings).unwrap()).unwrap();
+    assert_eq!(t["technique"], "shadow-map");
+    assert_eq!((t["width"].as_u64(), t["height"].as_u64(), t["frames"].as_u64()), (Some(96), Some(64), Some(3)));
+    assert!(t["device"].as_str().is_some_and(|d| !d.is_empty()) && t["driver"].is_string());
+    let passes = t["passes"].as_array().unwrap();
+    assert_eq!(passes.len(), 4);
+    for p in passes {
+        let (median, p95) = (p["gpu_ms_median"].as_f64().unwrap(), p["gpu_ms_p95"].as_f64().unwrap());
+        assert!(median > 0.0 && p95 >= median, "{p}");
+    }
+    assert!(t["gpu_ms_total_median"].as_f64().unwrap() > 0.0);
+    assert!(t["cpu_ms"].is_object());
+
+    let v = image::open(&vis).unwrap();
+    assert_eq!(v.color(), image::ColorType::L16, "visibility is 16-bit grayscale");
+    assert_eq!((v.width(), v.height()), (96, 64));
+    let c = image::open(&color).unwrap();
+    assert_eq!((c.width(), c.height()), (96, 64));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_arguments_fail_with_a_message() {
+    for (args, needle) in [
+        (vec!["render", "scenes/default.toml", "--technique", "nope"], "unknown technique"),
+        (vec!["render", "scenes/default.toml", "--set", "bias"], "KEY=VALUE"),
+        (vec!["render", "scenes/default.toml", "--set", "shadow_map_size=0"], "out of range"),
+        (vec!["render", "scenes/missing.toml"], "missing.toml"),
+        (vec!["render", "scenes/default.toml", "--width", "0"], "empty"),
+    ] {
+        let out = softshadow().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn techniques_lists_knobs_with_defaults() {
+    let out = softshadow().arg("techniques").output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success()
+            && text.contains("shadow-map")
+            && text.contains("shadow_map_size")
+            && text.contains("2048"),
+        "{text}"
+    );
+}

@@ -1,0 +1,44 @@
+//! Shared by the GPU tests: every engine runs with validation (and synchronization validation)
+//! on, and a test fails on any validation error, including objects left alive at exit.
+#![allow(dead_code)] // each test binary uses a different subset of these helpers
+
+use softshadow::gpu::ContextOptions;
+use softshadow::scene::Scene;
+use softshadow::{Engine, FrameSettings};
+
+pub fn engine() -> Engine {
+    Engine::headless(&ContextOptions { validation: true, device: None })
+        .expect("a Vulkan 1.3 device (lavapipe) with validation layers")
+}
+
+/// Destroys the engine and fails the test on any validation error.
+pub fn finish(engine: Engine) {
+    let errors = engine.finish();
+    assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
+}
+
+pub fn scene(text: &str) -> Scene {
+    Scene::from_toml(text, "tests/inline.toml").expect("valid test scene")
+}
+
+pub fn settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
+    let mut s = FrameSettings::from_scene(scene).expect("valid settings");
+    s.width = w;
+    s.height = h;
+    s
+}
+
+/// Centroid (x, y) in pixels of the receiver pixels darker than V = 0.5.
+pub fn shadow_centroid(c: &softshadow::Capture) -> Option<(f32, f32)> {
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+    for y in 0..c.height {
+        for x in 0..c.width {
+            if c.visibility_at(x, y) < 0.5 {
+                sx += x as f32;
+                sy += y as f32;
+                n += 1.0;
+            }
+        }
+    }
+    (n > 0.0).then(|| (sx / n, sy / n))
+}
