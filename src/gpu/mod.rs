@@ -18,7 +18,7 @@ pub use context::{Context, ContextOptions, DeviceInfo};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
 pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Binding, DepthState, Descriptor, Pipeline, PipelineDesc, VertexInput};
-pub use render::{Attachment, RenderPass, draw_fullscreen};
+pub use render::{Attachment, RenderPass, fullscreen};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{PassTime, PassTimer};
 pub use upload::upload;

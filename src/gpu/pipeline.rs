@@ -108,6 +108,30 @@ impl Pipeline {
         Ok(pipeline)
     }
 
+    /// A full-screen pass (`glsl/common/fullscreen.vert`) whose fragment shader reads `bindings`
+    /// and writes one color target of `format`.
+    pub fn fullscreen(
+        ctx: &Context,
+        name: &'static str,
+        fragment: &[u32],
+        bindings: &[Binding],
+        format: vk::Format,
+    ) -> Result<Self> {
+        let bindings: Vec<_> = bindings.iter().map(|b| (*b, vk::ShaderStageFlags::FRAGMENT)).collect();
+        Pipeline::new(
+            ctx,
+            &PipelineDesc {
+                name,
+                vertex: super::shaders::COMMON_FULLSCREEN_VERT,
+                fragment,
+                bindings: &bindings,
+                vertex_input: VertexInput::None,
+                color_formats: &[format],
+                depth: None,
+            },
+        )
+    }
+
     fn build(&mut self, ctx: &Context, desc: &PipelineDesc<'_>) -> Result<()> {
         let d = &ctx.device;
         let set_layouts = [self.set_layout];

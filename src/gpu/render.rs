@@ -3,6 +3,7 @@
 use ash::vk;
 
 use super::Context;
+use super::pipeline::{Descriptor, Pipeline};
 use super::target::Target;
 
 /// A target drawn into, cleared first or loaded.
@@ -76,7 +77,17 @@ impl RenderPass {
     }
 }
 
-/// Draws the full-screen triangle of `glsl/common/fullscreen.vert`.
-pub fn draw_fullscreen(ctx: &Context, cmd: vk::CommandBuffer) {
+/// Runs a [`Pipeline::fullscreen`] pass over all of `target` (already transitioned for
+/// writing; every pixel is overwritten, so nothing is loaded or cleared).
+pub fn fullscreen(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    pipeline: &Pipeline,
+    target: &Target,
+    inputs: &[Descriptor<'_>],
+) {
+    let pass = RenderPass::begin(ctx, cmd, &[Attachment { target, clear: None }], None);
+    pipeline.bind(ctx, cmd, inputs);
     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+    pass.end(ctx, cmd);
 }

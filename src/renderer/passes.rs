@@ -6,7 +6,7 @@ use super::{CameraTargets, Draw};
 use crate::error::Result;
 use crate::gpu::{
     Access, Attachment, Binding, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass,
-    VertexInput, draw_fullscreen, shaders, transition,
+    VertexInput, fullscreen, shaders, transition,
 };
 
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -92,25 +92,8 @@ pub struct Composite {
 
 impl Composite {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let f = vk::ShaderStageFlags::FRAGMENT;
-        let pipeline = Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: "composite",
-                vertex: shaders::COMMON_FULLSCREEN_VERT,
-                fragment: shaders::COMPOSITE_COMPOSITE_FRAG,
-                bindings: &[
-                    (Binding::Uniform, f),
-                    (Binding::Sampled, f),
-                    (Binding::Sampled, f),
-                    (Binding::Sampled, f),
-                    (Binding::Sampled, f),
-                ],
-                vertex_input: VertexInput::None,
-                color_formats: &[COLOR_FORMAT],
-                depth: None,
-            },
-        )?;
+        let b = [Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled, Binding::Sampled];
+        let pipeline = Pipeline::fullscreen(ctx, "composite", shaders::COMPOSITE_COMPOSITE_FRAG, &b, COLOR_FORMAT)?;
         Ok(Composite { pipeline })
     }
 
@@ -128,10 +111,11 @@ impl Composite {
             cmd,
             &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (&mut t.color, Access::COLOR_WRITE, true)],
         );
-        let pass = RenderPass::begin(ctx, cmd, &[Attachment { target: &t.color, clear: None }], None);
-        self.pipeline.bind(
+        fullscreen(
             ctx,
             cmd,
+            &self.pipeline,
+            &t.color,
             &[
                 Descriptor::Buffer(globals),
                 Descriptor::Image(&t.depth),
@@ -140,8 +124,6 @@ impl Composite {
                 Descriptor::Image(&t.visibility),
             ],
         );
-        draw_fullscreen(ctx, cmd);
-        pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
     }
 

@@ -17,7 +17,7 @@ use crate::error::Result;
 use crate::geometry::{LightFrustum, fit_spot_frustum};
 use crate::gpu::{
     Access, Attachment, Binding, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, PipelineDesc,
-    RenderPass, Target, TargetDesc, VertexInput, draw_fullscreen, ensure, shaders, transition,
+    RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
 };
 use crate::gpu_types::LightView;
 
@@ -174,25 +174,9 @@ pub struct ShadowMap {
 impl ShadowMap {
     pub fn new(ctx: &Context) -> Result<Self> {
         let pass = ShadowMapPass::new(ctx)?;
-        let fragment = vk::ShaderStageFlags::FRAGMENT;
-        let resolve = Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: "resolve",
-                vertex: shaders::COMMON_FULLSCREEN_VERT,
-                fragment: shaders::SHADOW_MAP_RESOLVE_FRAG,
-                bindings: &[
-                    (Binding::Uniform, fragment),
-                    (Binding::Uniform, fragment),
-                    (Binding::Sampled, fragment),
-                    (Binding::Sampled, fragment),
-                    (Binding::Sampled, fragment),
-                ],
-                vertex_input: VertexInput::None,
-                color_formats: &[crate::renderer::VISIBILITY_FORMAT],
-                depth: None,
-            },
-        );
+        let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
+        let format = crate::renderer::VISIBILITY_FORMAT;
+        let resolve = Pipeline::fullscreen(ctx, "resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, format);
         match resolve {
             Ok(resolve) => Ok(ShadowMap { pass, resolve }),
             Err(e) => {
@@ -216,10 +200,11 @@ impl Technique for ShadowMap {
         let (map, light) = self.pass.inputs(frame.slot);
         frame.timer.begin(ctx, cmd, "resolve");
         transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
-        let pass = RenderPass::begin(ctx, cmd, &[Attachment { target: visibility, clear: None }], None);
-        self.resolve.bind(
+        fullscreen(
             ctx,
             cmd,
+            &self.resolve,
+            visibility,
             &[
                 Descriptor::Buffer(frame.globals),
                 Descriptor::Buffer(light),
@@ -228,8 +213,6 @@ impl Technique for ShadowMap {
                 Descriptor::Image(map),
             ],
         );
-        draw_fullscreen(ctx, cmd);
-        pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
         Ok(())
     }
