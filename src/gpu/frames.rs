@@ -72,8 +72,9 @@ impl FrameRing {
         let slot = self.next;
         let earlier = self.wait(ctx, slot)?;
         let s = &mut self.slots[slot];
+        // The fence is reset only at submit: a frame abandoned on an error leaves it signalled,
+        // so the next frame on this slot does not wait forever.
         unsafe {
-            ctx.device.reset_fences(&[s.fence]).vk("vkResetFences")?;
             ctx.device.reset_command_buffer(s.cmd, vk::CommandBufferResetFlags::empty()).vk("vkResetCommandBuffer")?;
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             ctx.device.begin_command_buffer(s.cmd, &begin).vk("vkBeginCommandBuffer")?;
@@ -84,13 +85,15 @@ impl FrameRing {
 
     /// Ends and submits the frame begun last.
     pub fn submit(&mut self, ctx: &Context, slot: usize) -> Result<()> {
-        let s = &self.slots[slot];
+        let s = &mut self.slots[slot];
         unsafe {
             ctx.device.end_command_buffer(s.cmd).vk("vkEndCommandBuffer")?;
+            ctx.device.reset_fences(&[s.fence]).vk("vkResetFences")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(s.cmd)];
             let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
             ctx.device.queue_submit2(ctx.queue, &submit, s.fence).vk("vkQueueSubmit2")?;
         }
+        s.timer.submitted();
         self.next = (slot + 1) % FRAMES_IN_FLIGHT;
         Ok(())
     }
@@ -118,5 +121,34 @@ impl FrameRing {
             s.timer.destroy(ctx);
         }
         unsafe { ctx.device.destroy_command_pool(self.pool, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::ContextOptions;
+
+    /// A frame abandoned between `begin` and `submit` (an error while recording) must not block
+    /// the next frame on its slot, nor report timings for queries it never wrote.
+    #[test]
+    fn an_abandoned_frame_does_not_block_the_next() {
+        let ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
+        let mut ring = FrameRing::new(&ctx).unwrap();
+        for _ in 0..FRAMES_IN_FLIGHT + 1 {
+            let (frame, earlier) = ring.begin(&ctx).unwrap();
+            assert!(earlier.is_none());
+            let _ = frame; // dropped without submitting, as on an error
+        }
+        let (frame, _) = ring.begin(&ctx).unwrap();
+        let slot = frame.slot;
+        frame.timer.begin(&ctx, frame.cmd, "work");
+        frame.timer.end(&ctx, frame.cmd);
+        ring.submit(&ctx, slot).unwrap();
+        let timings = ring.wait(&ctx, slot).unwrap().expect("the submitted frame has timings");
+        assert_eq!(timings[0].name, "work");
+        ring.destroy(&ctx);
+        let errors = ctx.validation_errors();
+        assert!(errors.is_empty(), "{errors:?}");
     }
 }

@@ -37,6 +37,11 @@ impl PassTimer {
     pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
         unsafe { ctx.device.cmd_reset_query_pool(cmd, self.pool, 0, MAX_PASSES * 2) };
         self.names.clear();
+        self.recorded = false;
+    }
+
+    /// The frame was submitted: its queries will be written and can be collected.
+    pub fn submitted(&mut self) {
         self.recorded = true;
     }
 
@@ -65,8 +70,8 @@ impl PassTimer {
         }
     }
 
-    /// The recorded frame's pass times; call only after its fence signalled. `None` when nothing
-    /// was recorded since the last call.
+    /// The submitted frame's pass times; call only after its fence signalled. `None` when no
+    /// frame was submitted since the last call.
     pub fn collect(&mut self, ctx: &Context) -> Result<Option<Vec<PassTime>>> {
         if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
             return Ok(None);

@@ -254,7 +254,8 @@ impl Engine {
 
         let aspect = w as f32 / h as f32;
         let cam = &scene.camera;
-        let camera = CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, aspect, &scene.bounds());
+        let scene_bounds = draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
+        let camera = CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, aspect, &scene_bounds);
         let globals = FrameGlobals {
             view_proj: camera.view_proj,
             inv_view_proj: camera.inv_view_proj,

@@ -201,20 +201,6 @@ impl Scene {
         }
         Ok(())
     }
-
-    /// Bounds of everything drawn: objects and the ground.
-    pub fn bounds(&self) -> Aabb {
-        let ground = self.ground.map(|g| g.bounds()).unwrap_or(Aabb::EMPTY);
-        self.objects.iter().fold(ground, |b, o| b.union(&o.bounds()))
-    }
-
-    /// The casters' centre: where the light looks unless told otherwise.
-    pub fn light_target(&self) -> Vec3 {
-        self.light.target.unwrap_or_else(|| {
-            let casters = Aabb::from_points(self.objects.iter().filter(|o| o.casts).flat_map(|o| o.bounds().corners()));
-            if casters.is_empty() { self.light.position - Vec3::Y } else { casters.center() }
-        })
-    }
 }
 
 impl Ground {

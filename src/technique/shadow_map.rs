@@ -14,7 +14,7 @@ use glam::{Vec3, Vec4};
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
-use crate::geometry::{LightFrustum, fit_spot_frustum};
+use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
     Access, Attachment, Binding, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, PipelineDesc,
     RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
@@ -106,8 +106,13 @@ impl ShadowMapPass {
     /// Fits the frustum; `None` when no receiver in view can be shadowed (nothing to render).
     pub fn fit(frame: &FrameInputs<'_>) -> Option<LightFrustum> {
         let casters: Vec<Vec3> = frame.draws.iter().filter(|d| d.casts).flat_map(|d| d.bounds.corners()).collect();
-        let scene = frame.scene;
-        fit_spot_frustum(scene.light.position, scene.light_target(), &casters, frame.receivers_in_view)
+        if casters.is_empty() {
+            return None;
+        }
+        let light = &frame.scene.light;
+        // DESIGN.md §3: the spot looks at `light.target`, by default the casters' centre.
+        let aim = light.target.unwrap_or_else(|| Aabb::from_points(casters.iter().copied()).center());
+        fit_spot_frustum(light.position, aim, &casters, frame.receivers_in_view)
     }
 
     /// Records the map; afterwards it is ready to be sampled by fragment shaders.
