@@ -38,6 +38,19 @@ pub struct LightView {
     pub bias: Vec4,
 }
 
+/// One point sampled on the area light, with the view its shadow map was rendered through.
+/// Padded to 256 bytes, the largest uniform-buffer offset alignment Vulkan allows, so any one
+/// of an array can also be bound as a uniform buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightSample {
+    pub view: LightView,
+    /// xyz the point; w 1 when it has a shadow map, 0 when nothing in view can block it.
+    pub position: Vec4,
+    pub pad: [Vec4; 5],
+}
+
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 2 * 16);
+const _: () = assert!(std::mem::size_of::<LightSample>() == 256);

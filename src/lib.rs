@@ -23,6 +23,7 @@ pub mod geometry;
 pub mod gpu;
 mod gpu_types;
 pub mod measure;
+pub mod reference;
 pub mod renderer;
 pub mod scene;
 pub mod technique;

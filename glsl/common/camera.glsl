@@ -1,6 +1,7 @@
 // Reconstruction of camera-pass surfaces from the prepass targets.
 #ifndef SOFTSHADOW_CAMERA_GLSL
 #define SOFTSHADOW_CAMERA_GLSL
+#include "interface.glsl"
 
 // Reverse Z: the prepass clears depth to 0, so 0 means "no surface".
 bool sees_surface(float depth) { return depth > 0.0; }
@@ -9,6 +10,33 @@ vec3 world_position(mat4 inv_view_proj, vec2 uv, float depth) {
     vec4 clip = vec4(uv * 2.0 - 1.0, depth, 1.0);
     vec4 world = inv_view_proj * clip;
     return world.xyz / world.w;
+}
+
+// The normal target's alpha: how the surface takes part in shadowing (see `shadow_role` in
+// src/renderer/mod.rs): 0 receives no shadow, 0.5 receives, 1 receives and casts.
+struct Surface {
+    vec3 p;        // world position
+    vec3 n;        // unit normal on the side facing the camera
+    bool receives; // false: V = 1 here (also where no surface is seen)
+    bool casts;    // the surface belongs to a caster, so it blocks light arriving from behind it
+};
+
+Surface read_surface(FrameGlobals frame, sampler2D depth_target, sampler2D normal_target, vec2 uv) {
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    float depth = texelFetch(depth_target, pixel, 0).r;
+    vec4 normal_role = texelFetch(normal_target, pixel, 0);
+    Surface s;
+    s.receives = sees_surface(depth) && normal_role.a > 0.25;
+    s.casts = normal_role.a > 0.75;
+    s.p = s.receives ? world_position(frame.inv_view_proj, uv, depth) : vec3(0.0);
+    s.n = s.receives ? normalize(normal_role.xyz) : vec3(0.0, 1.0, 0.0);
+    return s;
+}
+
+// A caster's own surface hides whatever lies behind its tangent plane: a point q of the light
+// there is blocked whatever a shadow map says (rays from the camera's side cross the surface).
+bool hides_itself(Surface s, vec3 q) {
+    return s.casts && dot(s.n, q - s.p) <= 0.0;
 }
 
 #endif

@@ -20,7 +20,7 @@ struct FrameGlobals {
 struct ObjectData {
     mat4 model;          // object -> world
     mat4 normal_matrix;  // inverse transpose of the model's 3x3, in the upper left
-    vec4 albedo;         // rgb linear albedo; a = 1 if the object receives shadows, else 0
+    vec4 albedo;         // rgb linear albedo; a = shadow role: 0 no shadows, 0.5 receives, 1 receives + casts
 };
 
 // A perspective view from the light (the spot frustum of DESIGN.md's shadow map).
@@ -29,6 +29,14 @@ struct LightView {
     mat4 view_proj;  // world -> light clip
     vec4 extent;     // tangent-space window: x0, y0, x1, y1 (x/z and y/z of the frustum's sides)
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
+};
+
+// A point sampled on the area light and the view its shadow map was rendered through (the
+// reference's accumulation). 256 bytes, so one element can also be bound as a uniform buffer.
+struct LightSample {
+    LightView view;
+    vec4 position;   // xyz; w = 1 with a shadow map, 0 when nothing in view can block it
+    vec4 pad[5];
 };
 
 #endif

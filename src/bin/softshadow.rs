@@ -5,10 +5,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
-use softshadow::measure::TimingReport;
+use softshadow::measure::{Metrics, TimingReport, save_difference};
 use softshadow::scene::Scene;
-use softshadow::technique::{TECHNIQUES, knobs};
-use softshadow::{Engine, FrameSettings};
+use softshadow::technique::{Params, TECHNIQUES, knobs};
+use softshadow::{Capture, Engine, FrameSettings};
 
 /// Frames rendered before timing starts (pipelines warm, caches filled).
 const WARMUP_FRAMES: usize = 3;
@@ -24,14 +24,17 @@ struct Cli {
 enum Command {
     /// Render a scene file to images and timings.
     Render(RenderArgs),
+    /// Render a technique and a reference, and print how wrong the technique is.
+    Compare(CompareArgs),
     /// List the techniques and their knobs with defaults.
     Techniques,
     /// Show the Vulkan device, driver and limits.
     Info,
 }
 
+/// What to render: a scene, a technique and its knobs, a size.
 #[derive(clap::Args)]
-struct RenderArgs {
+struct SceneArgs {
     /// The scene file (TOML).
     scene: PathBuf,
     /// Technique; overrides the scene's `[render] technique`.
@@ -44,6 +47,15 @@ struct RenderArgs {
     width: Option<u32>,
     #[arg(long)]
     height: Option<u32>,
+    /// Frames to time after warm-up [default: 20; 1 without warm-up for offline techniques].
+    #[arg(long)]
+    frames: Option<usize>,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    what: SceneArgs,
     /// Color image (PNG).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -53,9 +65,24 @@ struct RenderArgs {
     /// Timings JSON.
     #[arg(long)]
     timings: Option<PathBuf>,
-    /// Frames to time (after warm-up frames).
-    #[arg(long, default_value_t = 20)]
-    frames: usize,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    #[command(flatten)]
+    what: SceneArgs,
+    /// The ground truth: `reference` (GPU) or `raytrace` (CPU).
+    #[arg(long, default_value = "reference")]
+    against: String,
+    /// A knob of the ground truth, KEY=VALUE; repeatable.
+    #[arg(long = "against-set", value_name = "KEY=VALUE")]
+    against_set: Vec<String>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Signed error image (PNG): red too light, blue too dark, magenta different surfaces.
+    #[arg(long)]
+    diff: Option<PathBuf>,
 }
 
 fn main() {
@@ -68,6 +95,7 @@ fn main() {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => render(&args).map(|_| ()),
+        Some(Command::Compare(args)) => compare(&args),
         Some(Command::Techniques) => {
             for t in TECHNIQUES {
                 println!("{}: {}", t.name, t.summary);
@@ -98,15 +126,10 @@ fn default_run() -> Result<()> {
     let out = PathBuf::from("out");
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let args = RenderArgs {
-        scene,
-        technique: None,
-        set: Vec::new(),
-        width: None,
-        height: None,
+        what: SceneArgs { scene, technique: None, set: Vec::new(), width: None, height: None, frames: None },
         out: Some(out.join("color.png")),
         visibility: Some(out.join("visibility.png")),
         timings: Some(out.join("timings.json")),
-        frames: 20,
     };
     let report = render(&args)?;
     println!(
@@ -122,7 +145,17 @@ fn default_run() -> Result<()> {
     Ok(())
 }
 
-fn render(args: &RenderArgs) -> Result<TimingReport> {
+/// Applies `KEY=VALUE` pairs to `params`.
+fn apply_sets(params: &mut Params, pairs: &[String]) -> Result<()> {
+    for pair in pairs {
+        let Some((k, v)) = pair.split_once('=') else { bail!("--set takes KEY=VALUE, got `{pair}`") };
+        params.set(k.trim(), v)?;
+    }
+    Ok(())
+}
+
+/// The scene with the command line's technique, size and knobs applied.
+fn load(args: &SceneArgs) -> Result<(Scene, FrameSettings)> {
     let mut scene = Scene::load(&args.scene)?;
     if let Some(t) = &args.technique {
         knobs::find(t)?;
@@ -135,23 +168,48 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
     scene.render.width = args.width.unwrap_or(scene.render.width);
     scene.render.height = args.height.unwrap_or(scene.render.height);
     let mut settings = FrameSettings::from_scene(&scene)?;
-    for pair in &args.set {
-        let Some((k, v)) = pair.split_once('=') else { bail!("--set takes KEY=VALUE, got `{pair}`") };
-        settings.params.set(k.trim(), v)?;
-    }
-    if args.frames == 0 {
+    apply_sets(&mut settings.params, &args.set)?;
+    Ok((scene, settings))
+}
+
+/// Renders warm-up frames and `frames` timed frames, the last one captured. Offline techniques
+/// default to one frame without warm-up.
+fn render_frames(
+    engine: &mut Engine,
+    scene: &Scene,
+    settings: &FrameSettings,
+    frames: Option<usize>,
+) -> Result<(Capture, TimingReport)> {
+    let offline = settings.params.technique.offline;
+    let frames = frames.unwrap_or(if offline { 1 } else { 20 });
+    if frames == 0 {
         bail!("--frames must be at least 1");
     }
-
-    let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    for _ in 0..WARMUP_FRAMES + args.frames - 1 {
-        engine.render(&scene, &settings)?;
+    let warmup = if offline { 0 } else { WARMUP_FRAMES };
+    for _ in 0..warmup + frames - 1 {
+        engine.render(scene, settings)?;
     }
-    let capture = engine.render_and_capture(&scene, &settings)?;
+    let capture = engine.render_and_capture(scene, settings)?;
     engine.flush()?;
     let timings = engine.take_timings();
-    let measured = &timings[timings.len().saturating_sub(args.frames)..];
-    let report = TimingReport::new(engine.device(), &scene.render.technique, settings.width, settings.height, measured);
+    let measured = &timings[timings.len().saturating_sub(frames)..];
+    let name = settings.params.technique.name;
+    let report = TimingReport::new(engine.device(), name, settings.width, settings.height, measured);
+    Ok((capture, report))
+}
+
+fn finish(engine: Engine) -> Result<()> {
+    let errors = engine.finish();
+    if !errors.is_empty() {
+        bail!("{} Vulkan validation error(s), the first: {}", errors.len(), errors[0]);
+    }
+    Ok(())
+}
+
+fn render(args: &RenderArgs) -> Result<TimingReport> {
+    let (scene, settings) = load(&args.what)?;
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let (capture, report) = render_frames(&mut engine, &scene, &settings, args.what.frames)?;
     if let Some(p) = &args.out {
         capture.save_color(p)?;
     }
@@ -162,9 +220,69 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
         let json = serde_json::to_string_pretty(&report)?;
         std::fs::write(p, json + "\n").with_context(|| format!("writing {}", p.display()))?;
     }
-    let errors = engine.finish();
-    if !errors.is_empty() {
-        bail!("{} Vulkan validation error(s), the first: {}", errors.len(), errors[0]);
-    }
+    finish(engine)?;
     Ok(report)
+}
+
+/// `compare`: the technique's metrics against a ground truth on the same camera pixels.
+fn compare(args: &CompareArgs) -> Result<()> {
+    let (scene, settings) = load(&args.what)?;
+    let against = knobs::find(&args.against)?;
+    if !against.offline {
+        bail!("--against takes a ground truth (reference or raytrace), not `{}`", against.name);
+    }
+    let mut truth = FrameSettings { params: Params::defaults(against), ..settings.clone() };
+    apply_sets(&mut truth.params, &args.against_set)?;
+
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let (capture, report) = render_frames(&mut engine, &scene, &settings, args.what.frames)?;
+    let (reference, reference_report) = render_frames(&mut engine, &scene, &truth, None)?;
+    let metrics = Metrics::between(&capture, &reference)?;
+    if let Some(p) = &args.diff {
+        save_difference(&capture, &reference, p)?;
+    }
+    finish(engine)?;
+
+    if args.json {
+        let json = serde_json::json!({
+            "scene": args.what.scene,
+            "technique": settings.params.technique.name,
+            "params": settings.params.to_string(),
+            "against": against.name,
+            "against_params": truth.params.to_string(),
+            "timings": report,
+            "against_timings": reference_report,
+            "metrics": metrics,
+        });
+        println!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(());
+    }
+    println!("{} [{}] against {} [{}]", report.technique, settings.params, against.name, truth.params);
+    println!(
+        "{}, {}x{}, {} ({})",
+        args.what.scene.display(),
+        report.width,
+        report.height,
+        report.device,
+        report.driver
+    );
+    println!("{:<28} {:>12}", "GPU ms (median)", format!("{:.3}", report.gpu_ms_total_median));
+    println!("{:<28} {:>12}", "reference GPU ms", format!("{:.3}", reference_report.gpu_ms_total_median));
+    let m = &metrics;
+    let rows: [(&str, String); 10] = [
+        ("receiver pixels compared", m.pixels.to_string()),
+        ("excluded (other surface)", m.excluded.to_string()),
+        ("RMSE", format!("{:.5}", m.rmse)),
+        ("MAE", format!("{:.5}", m.mae)),
+        ("max |error|", format!("{:.5}", m.max_abs)),
+        ("99th percentile |error|", format!("{:.5}", m.p99_abs)),
+        ("penumbra RMSE", format!("{:.5} ({} px)", m.penumbra_rmse, m.penumbra_pixels)),
+        ("light-leak rate (> +0.1)", format!("{:.5}", m.leak_rate)),
+        ("over-darkening rate (< -0.1)", format!("{:.5}", m.dark_rate)),
+        ("mean bias", format!("{:+.5}", m.mean_bias)),
+    ];
+    for (name, value) in rows {
+        println!("{name:<28} {value:>12}");
+    }
+    Ok(())
 }

@@ -3,7 +3,7 @@
 //! with −up' (row 0 at the top). Depth is reversed (near 1, far 0) for float precision, and the
 //! near and far planes are fitted to the scene's bounds every frame, never hard-coded.
 
-use glam::{DMat4, DVec4, Mat4, Vec3};
+use glam::{DMat4, DVec4, Mat4, Vec2, Vec3};
 
 use super::{Aabb, Hexahedron};
 
@@ -21,7 +21,10 @@ pub enum Projection {
 pub struct CameraProjection {
     pub view_proj: Mat4,
     pub inv_view_proj: Mat4,
+    pub position: Vec3,
     pub forward: Vec3,
+    /// `inv_view_proj` in double precision, for rays and positions rebuilt on the CPU.
+    inv64: DMat4,
     /// The view volume between the fitted near and far planes.
     pub frustum: Hexahedron,
 }
@@ -87,9 +90,29 @@ impl CameraProjection {
         CameraProjection {
             view_proj: view_proj.as_mat4(),
             inv_view_proj: inv.as_mat4(),
+            position,
             forward: forward.as_vec3(),
+            inv64: inv,
             frustum: Hexahedron { corners },
         }
+    }
+
+    fn unproject(&self, uv: Vec2, depth: f64) -> glam::DVec3 {
+        let ndc = uv.as_dvec2() * 2.0 - 1.0;
+        let w = self.inv64 * DVec4::new(ndc.x, ndc.y, depth, 1.0);
+        w.truncate() / w.w
+    }
+
+    /// The ray through image point `uv` ((0, 0) the top-left corner, (1, 1) the bottom-right),
+    /// from the near plane: the same ray the rasterizer samples there.
+    pub fn ray(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let (near, far) = (self.unproject(uv, 1.0), self.unproject(uv, 0.0));
+        (near.as_vec3(), (far - near).normalize().as_vec3())
+    }
+
+    /// Distance along the camera's forward axis of the point at `uv` with reverse-Z `depth`.
+    pub fn view_depth(&self, uv: Vec2, depth: f32) -> f32 {
+        (self.unproject(uv, depth as f64) - self.position.as_dvec3()).dot(self.forward.as_dvec3()) as f32
     }
 }
 

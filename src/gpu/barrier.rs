@@ -52,6 +52,12 @@ impl Access {
         access: vk::AccessFlags2::SHADER_SAMPLED_READ,
         layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
     };
+    /// Written by a copy (an image computed on the CPU).
+    pub const COPY_WRITE: Access = Access {
+        stage: vk::PipelineStageFlags2::COPY,
+        access: vk::AccessFlags2::TRANSFER_WRITE,
+        layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+    };
     /// Copied out for readback.
     pub const COPY_READ: Access = Access {
         stage: vk::PipelineStageFlags2::COPY,

@@ -50,6 +50,17 @@ pub struct DepthState {
     pub compare: vk::CompareOp,
 }
 
+/// How fragment outputs combine with what a color target holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// Overwrite.
+    None,
+    /// dst + src: accumulation (Heckbert & Herf's accumulation buffer).
+    Add,
+    /// min(dst, src): the darkest value wins.
+    Min,
+}
+
 /// A graphics pipeline's description.
 pub struct PipelineDesc<'a> {
     pub name: &'static str,
@@ -60,6 +71,8 @@ pub struct PipelineDesc<'a> {
     pub vertex_input: VertexInput,
     pub color_formats: &'a [vk::Format],
     pub depth: Option<DepthState>,
+    /// Applied to every color target.
+    pub blend: Blend,
 }
 
 /// A pipeline, its layout and its push-descriptor set layout.
@@ -109,13 +122,25 @@ impl Pipeline {
     }
 
     /// A full-screen pass (`glsl/common/fullscreen.vert`) whose fragment shader reads `bindings`
-    /// and writes one color target of `format`.
+    /// and overwrites one color target of `format`.
     pub fn fullscreen(
         ctx: &Context,
         name: &'static str,
         fragment: &[u32],
         bindings: &[Binding],
         format: vk::Format,
+    ) -> Result<Self> {
+        Pipeline::fullscreen_blended(ctx, name, fragment, bindings, format, Blend::None)
+    }
+
+    /// [`Pipeline::fullscreen`] whose output is blended into the target.
+    pub fn fullscreen_blended(
+        ctx: &Context,
+        name: &'static str,
+        fragment: &[u32],
+        bindings: &[Binding],
+        format: vk::Format,
+        blend: Blend,
     ) -> Result<Self> {
         let bindings: Vec<_> = bindings.iter().map(|b| (*b, vk::ShaderStageFlags::FRAGMENT)).collect();
         Pipeline::new(
@@ -128,6 +153,7 @@ impl Pipeline {
                 vertex_input: VertexInput::None,
                 color_formats: &[format],
                 depth: None,
+                blend,
             },
         )
     }
@@ -193,11 +219,20 @@ impl Pipeline {
             .depth_test_enable(desc.depth.is_some())
             .depth_write_enable(desc.depth.is_some())
             .depth_compare_op(desc.depth.map_or(vk::CompareOp::ALWAYS, |d| d.compare));
-        let blend: Vec<_> = desc
-            .color_formats
-            .iter()
-            .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
-            .collect();
+        let op = match desc.blend {
+            Blend::None | Blend::Add => vk::BlendOp::ADD,
+            Blend::Min => vk::BlendOp::MIN,
+        };
+        let attachment = vk::PipelineColorBlendAttachmentState::default()
+            .color_write_mask(vk::ColorComponentFlags::RGBA)
+            .blend_enable(desc.blend != Blend::None)
+            .src_color_blend_factor(vk::BlendFactor::ONE)
+            .dst_color_blend_factor(vk::BlendFactor::ONE)
+            .color_blend_op(op)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .alpha_blend_op(op);
+        let blend = vec![attachment; desc.color_formats.len()];
         let blend_state = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
         let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
         let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);

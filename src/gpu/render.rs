@@ -72,6 +72,22 @@ impl RenderPass {
         RenderPass
     }
 
+    /// Restricts drawing to `area` of the attachments (one tile of an atlas).
+    pub fn set_area(&self, ctx: &Context, cmd: vk::CommandBuffer, area: vk::Rect2D) {
+        let viewport = vk::Viewport {
+            x: area.offset.x as f32,
+            y: area.offset.y as f32,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        unsafe {
+            ctx.device.cmd_set_viewport(cmd, 0, &[viewport]);
+            ctx.device.cmd_set_scissor(cmd, 0, &[area]);
+        }
+    }
+
     pub fn end(self, ctx: &Context, cmd: vk::CommandBuffer) {
         unsafe { ctx.device.cmd_end_rendering(cmd) };
     }

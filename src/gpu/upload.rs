@@ -1,10 +1,13 @@
-//! One-time uploads of static data (meshes) into device-local buffers.
+//! One-time uploads of static data (meshes) into device-local buffers, and per-frame copies of
+//! CPU-computed images into targets.
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 use super::Context;
+use super::barrier::{Access, transition};
 use super::memory::Buffer;
+use super::target::Target;
 use crate::error::{Result, VkContext};
 
 /// Creates a device-local buffer holding `bytes`, through a staging buffer, and waits for it.
@@ -72,4 +75,33 @@ fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Res
     let result = run();
     unsafe { d.destroy_command_pool(pool, None) };
     result
+}
+
+/// Records a copy of tightly packed texels from `src` (a host-visible range written this frame)
+/// into all of `target`, whose old contents are discarded.
+pub fn copy_to_target(ctx: &Context, cmd: vk::CommandBuffer, src: vk::DescriptorBufferInfo, target: &mut Target) {
+    transition(ctx, cmd, &mut [(target, Access::COPY_WRITE, true)]);
+    let extent = target.extent();
+    let region = vk::BufferImageCopy {
+        buffer_offset: src.offset,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: target.desc.aspect(),
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
+    };
+    unsafe {
+        ctx.device.cmd_copy_buffer_to_image(
+            cmd,
+            src.buffer,
+            target.image,
+            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+            &[region],
+        )
+    };
 }

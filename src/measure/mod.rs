@@ -1,5 +1,7 @@
-//! Measurement: GPU timing reports (and, later, error metrics against the reference).
+//! Measurement: GPU timing reports and error metrics against the reference.
 
+mod metrics;
 mod timings;
 
+pub use metrics::{GROSS_ERROR, Metrics, PENUMBRA, save_difference};
 pub use timings::{PassSummary, TimingReport};

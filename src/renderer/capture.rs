@@ -1,50 +1,70 @@
-//! Readback of the color and visibility images, and their PNG files (DESIGN.md §3).
+//! Readback of the color and visibility images, and their PNG files (DESIGN.md §3), with the
+//! surfaces V was estimated at, so that two renders can be compared pixel by pixel.
 
 use std::path::Path;
 
 use ash::vk;
+use glam::Vec2;
 
 use super::CameraTargets;
 use crate::error::{Error, Result};
+use crate::geometry::CameraProjection;
 use crate::gpu::{Buffer, Context};
 
-/// Bytes for one frame: RGBA8 color, then R16 visibility.
+/// Bytes per pixel read back: RGBA8 color, D32 depth, RGBA16F normal + receives, R16 V.
+const PIXEL_BYTES: [u64; 4] = [4, 4, 8, 2];
+
 pub(super) fn readback_size(w: u32, h: u32) -> u64 {
-    w as u64 * h as u64 * (4 + 2)
+    w as u64 * h as u64 * PIXEL_BYTES.iter().sum::<u64>()
 }
 
 pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTargets, dst: &Buffer) {
     let extent = t.color.extent();
-    let region = |offset: u64| vk::BufferImageCopy {
-        buffer_offset: offset,
-        buffer_row_length: 0,
-        buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers {
-            aspect_mask: vk::ImageAspectFlags::COLOR,
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        },
-        image_offset: vk::Offset3D::default(),
-        image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
-    };
-    let color_bytes = extent.width as u64 * extent.height as u64 * 4;
-    unsafe {
-        ctx.device.cmd_copy_image_to_buffer(
-            cmd,
-            t.color.image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            dst.buffer,
-            &[region(0)],
-        );
-        ctx.device.cmd_copy_image_to_buffer(
-            cmd,
-            t.visibility.image,
-            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-            dst.buffer,
-            &[region(color_bytes)],
-        );
+    let pixels = extent.width as u64 * extent.height as u64;
+    let mut offset = 0;
+    for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(PIXEL_BYTES) {
+        let region = vk::BufferImageCopy {
+            buffer_offset: offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: target.desc.aspect(),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
+        };
+        unsafe {
+            ctx.device.cmd_copy_image_to_buffer(
+                cmd,
+                target.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                dst.buffer,
+                &[region],
+            )
+        };
+        offset += pixels * bytes;
     }
+}
+
+/// The surfaces a visibility image was estimated at.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surfaces {
+    /// Distance along the camera's forward axis; infinite where no surface is seen.
+    pub depth: Vec<f32>,
+    /// The surface receives shadows (V means something there).
+    pub receives: Vec<bool>,
+}
+
+/// 0.25 as an IEEE half float: shadow roles above it receive (`shadow_role` in mod.rs).
+const HALF_QUARTER: u16 = 0x3400;
+
+/// The image point (0..1, row 0 at the top) at the centre of pixel `index` of a row-major image.
+pub fn pixel_uv(index: usize, width: u32, height: u32) -> Vec2 {
+    let (x, y) = (index % width as usize, index / width as usize);
+    Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32)
 }
 
 /// One frame's images on the CPU. Row 0 is the top of the image.
@@ -56,15 +76,35 @@ pub struct Capture {
     pub color: Vec<u8>,
     /// V as round(V · 65535); 1 (65535) where no surface is seen.
     pub visibility: Vec<u16>,
+    /// Where V was estimated: the prepass's surfaces, or the ones a ray tracer found.
+    pub surfaces: Surfaces,
 }
 
 impl Capture {
-    pub(super) fn read(buffer: &Buffer, width: u32, height: u32) -> Self {
-        let bytes = buffer.read();
+    pub(super) fn read(buffer: &Buffer, width: u32, height: u32, camera: &CameraProjection) -> Self {
         let n = width as usize * height as usize;
-        let color = bytes[..n * 4].to_vec();
-        let visibility = bytes[n * 4..n * 6].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect();
-        Capture { width, height, color, visibility }
+        let mut parts = Vec::new();
+        let mut rest = buffer.read();
+        for bytes in PIXEL_BYTES {
+            let (part, tail) = rest.split_at(n * bytes as usize);
+            parts.push(part);
+            rest = tail;
+        }
+        let color = parts[0].to_vec();
+        let depth = parts[1]
+            .chunks_exact(4)
+            .enumerate()
+            .map(|(i, b)| {
+                let d = f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
+                // Reverse Z: the prepass clears to 0, "no surface".
+                if d > 0.0 { camera.view_depth(pixel_uv(i, width, height), d) } else { f32::INFINITY }
+            })
+            .collect();
+        // The normal target's alpha (a half float, 0, 0.5 or 1) is the shadow role; positive
+        // halfs order like their bits.
+        let receives = parts[2].chunks_exact(8).map(|b| u16::from_ne_bytes([b[6], b[7]]) > HALF_QUARTER).collect();
+        let visibility = parts[3].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect();
+        Capture { width, height, color, visibility, surfaces: Surfaces { depth, receives } }
     }
 
     /// V at pixel (x, y) in [0, 1].

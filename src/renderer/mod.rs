@@ -14,7 +14,7 @@ use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
-pub use capture::Capture;
+pub use capture::{Capture, Surfaces, pixel_uv};
 pub use draw::Draw;
 use draw::MeshCache;
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass};
@@ -75,10 +75,12 @@ impl CameraTargets {
         let sampled = vk::ImageUsageFlags::SAMPLED;
         let readback = vk::ImageUsageFlags::TRANSFER_SRC;
         let descs = [
-            TargetDesc::depth("camera depth", w, h).usage(sampled),
-            TargetDesc::color("camera normal", NORMAL_FORMAT, w, h),
+            TargetDesc::depth("camera depth", w, h).usage(sampled | readback),
+            TargetDesc::color("camera normal", NORMAL_FORMAT, w, h).usage(readback),
             TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
-            TargetDesc::color("visibility", VISIBILITY_FORMAT, w, h).usage(readback),
+            // CPU techniques (`raytrace`, `parker`) copy V in.
+            TargetDesc::color("visibility", VISIBILITY_FORMAT, w, h)
+                .usage(readback | vk::ImageUsageFlags::TRANSFER_DST),
             TargetDesc::color("color", COLOR_FORMAT, w, h).usage(readback),
         ];
         let mut made = Vec::new();
@@ -228,13 +230,18 @@ impl Engine {
             let bounds = o.mesh.bounds.transformed(&model);
             let instance = objects.len() as u32;
             draws.push(self.meshes.draw(ctx, &o.mesh, number, instance, bounds, (o.casts, o.receives))?);
-            objects.push(object_data(model, Mat4::from_mat3(o.normal_matrix()), o.color, o.receives));
+            objects.push(object_data(
+                model,
+                Mat4::from_mat3(o.normal_matrix()),
+                o.color,
+                shadow_role(o.receives, o.casts),
+            ));
         }
         if let Some(g) = &scene.ground {
             let model = ground_model(g);
             let instance = objects.len() as u32;
             draws.push(self.meshes.draw(ctx, &self.ground_mesh, number, instance, g.bounds(), (false, true))?);
-            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, true));
+            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, shadow_role(true, false)));
         }
         let bytes: &[u8] = cast_slice(&objects);
         if self.objects.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
@@ -307,6 +314,8 @@ impl Engine {
                 frame.cmd,
                 &mut [
                     (&mut targets.color, Access::COPY_READ, false),
+                    (&mut targets.depth, Access::COPY_READ, false),
+                    (&mut targets.normal, Access::COPY_READ, false),
                     (&mut targets.visibility, Access::COPY_READ, false),
                 ],
             );
@@ -324,7 +333,13 @@ impl Engine {
         let frames = self.frames.as_mut().expect("engine is built");
         let done = frames.wait(&self.ctx, slot)?;
         self.push_timings(done);
-        Ok(Some(Capture::read(self.readback.as_ref().expect("ensured"), w, h)))
+        let mut capture = Capture::read(self.readback.as_ref().expect("ensured"), w, h, &camera);
+        if let Some((_, t)) = &self.technique
+            && let Some(surfaces) = t.traced_surfaces()
+        {
+            capture.surfaces = surfaces.clone();
+        }
+        Ok(Some(capture))
     }
 
     fn ensure_targets(&mut self, w: u32, h: u32) -> Result<()> {
@@ -374,8 +389,18 @@ impl Drop for Engine {
     }
 }
 
-fn object_data(model: Mat4, normal: Mat4, color: Vec3, receives: bool) -> ObjectData {
-    ObjectData { model, normal_matrix: normal, albedo: color.extend(if receives { 1.0 } else { 0.0 }) }
+/// How a surface takes part in shadowing, as the prepass writes it into the normal target's
+/// alpha (`glsl/common/camera.glsl`): 0 receives no shadow, 0.5 receives, 1 receives and casts.
+fn shadow_role(receives: bool, casts: bool) -> f32 {
+    match (receives, casts) {
+        (false, _) => 0.0,
+        (true, false) => 0.5,
+        (true, true) => 1.0,
+    }
+}
+
+fn object_data(model: Mat4, normal: Mat4, color: Vec3, role: f32) -> ObjectData {
+    ObjectData { model, normal_matrix: normal, albedo: color.extend(role) }
 }
 
 /// The ground is the unit plate scaled to the ground's square, at its height.

@@ -5,7 +5,7 @@ use ash::vk;
 use super::{CameraTargets, Draw};
 use crate::error::Result;
 use crate::gpu::{
-    Access, Attachment, Binding, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass,
+    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass,
     VertexInput, fullscreen, shaders, transition,
 };
 
@@ -32,6 +32,7 @@ impl Prepass {
                 color_formats: &[NORMAL_FORMAT, ALBEDO_FORMAT],
                 // Reverse Z: nearer is greater.
                 depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),
+                blend: Blend::None,
             },
         )?;
         Ok(Prepass { pipeline })

@@ -243,5 +243,6 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
         color: Vec3::from(o.color.unwrap_or(PALETTE[index % PALETTE.len()])),
         casts: o.casts,
         receives: o.receives,
+        sphere_radius: if o.shape == Shape::Sphere { o.radius } else { None },
     })
 }

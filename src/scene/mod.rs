@@ -73,6 +73,9 @@ pub struct Object {
     pub color: Vec3,
     pub casts: bool,
     pub receives: bool,
+    /// The mesh tessellates a sphere of this radius about the object's origin (`shape =
+    /// "sphere"`): techniques that can treat spheres exactly may.
+    pub sphere_radius: Option<f32>,
 }
 
 impl Object {
@@ -84,7 +87,16 @@ impl Object {
             color: Vec3::splat(0.8),
             casts: true,
             receives: true,
+            sphere_radius: None,
         }
+    }
+
+    /// The exact sphere (world centre, radius) this object stands for, when it is one and its
+    /// scale is uniform.
+    pub fn sphere(&self) -> Option<(Vec3, f32)> {
+        let s = self.transform.scale;
+        let uniform = (s.x - s.y).abs() <= 1e-6 * s.x && (s.x - s.z).abs() <= 1e-6 * s.x;
+        self.sphere_radius.filter(|_| uniform).map(|r| (self.transform.position, r * s.x))
     }
 
     /// World-space bounds of the transformed mesh.

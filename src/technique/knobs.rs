@@ -23,10 +23,17 @@ pub struct TechniqueInfo {
     pub name: &'static str,
     pub summary: &'static str,
     pub knobs: &'static [Knob],
+    /// Takes seconds per frame (ground truth, CPU tracers): tools render it once, unwarmed.
+    pub offline: bool,
 }
 
 /// Every technique this build knows.
-pub const TECHNIQUES: &[&TechniqueInfo] = &[&crate::technique::shadow_map::INFO];
+pub const TECHNIQUES: &[&TechniqueInfo] = &[
+    &crate::technique::shadow_map::INFO,
+    &crate::technique::reference::INFO,
+    &crate::technique::traced::RAYTRACE,
+    &crate::technique::traced::PARKER,
+];
 
 /// Looks a technique up by name.
 pub fn find(name: &str) -> Result<&'static TechniqueInfo> {
@@ -79,6 +86,15 @@ impl Params {
     /// The value of a knob this technique declares.
     pub(crate) fn get(&self, name: &str) -> f64 {
         self.values[name]
+    }
+}
+
+/// `name=value` for every knob, in declaration order.
+impl std::fmt::Display for Params {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let pairs: Vec<_> =
+            self.technique.knobs.iter().map(|k| format!("{}={}", k.name, self.values[k.name])).collect();
+        f.write_str(&pairs.join(" "))
     }
 }
 

@@ -2,7 +2,9 @@
 //! A technique builds only what the scene in front of it needs.
 
 pub mod knobs;
+pub mod reference;
 pub mod shadow_map;
+pub mod traced;
 
 use ash::vk;
 use glam::Vec3;
@@ -35,9 +37,15 @@ pub struct FrameInputs<'a> {
     pub receivers_in_view: &'a [Vec3],
 }
 
-/// A shadowing technique: records its passes and leaves V written (as a color attachment).
+/// A shadowing technique: records its passes and leaves V written (the composite transitions
+/// it from whichever access wrote it).
 pub trait Technique {
     fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()>;
+    /// The surfaces V was estimated at in the last frame, when the technique found them itself
+    /// (a ray tracer) instead of reading the prepass.
+    fn traced_surfaces(&self) -> Option<&crate::renderer::Surfaces> {
+        None
+    }
     fn destroy(self: Box<Self>, ctx: &Context);
 }
 
@@ -45,6 +53,9 @@ pub trait Technique {
 pub fn create(ctx: &Context, info: &TechniqueInfo) -> Result<Box<dyn Technique>> {
     match info.name {
         name if name == shadow_map::INFO.name => Ok(Box::new(shadow_map::ShadowMap::new(ctx)?)),
+        name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx)?)),
+        name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
+        name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),
         other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),
     }
 }

@@ -16,12 +16,13 @@ use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
-    Access, Attachment, Binding, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, PipelineDesc,
-    RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline,
+    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
 };
 use crate::gpu_types::LightView;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
+    offline: false,
     name: "shadow-map",
     summary: "hard shadows from the light's centre: one shadow map, 2x2 bilinear comparison",
     knobs: &[
@@ -64,7 +65,34 @@ pub const SHADOW_MAP_SIZE: Knob = Knob {
 };
 
 /// Linear depth cleared beyond any caster: "nothing blocks this texel".
-const EMPTY_DEPTH: f32 = f32::MAX;
+pub(crate) const EMPTY_DEPTH: f32 = f32::MAX;
+
+/// Renders the casters' linear light depth (R32_SFLOAT) through the `LightView` at binding 0.
+pub(crate) fn depth_pipeline(ctx: &Context) -> Result<Pipeline> {
+    Pipeline::new(
+        ctx,
+        &PipelineDesc {
+            name: "shadow_map",
+            vertex: shaders::SHADOW_MAP_DEPTH_VERT,
+            fragment: shaders::SHADOW_MAP_DEPTH_FRAG,
+            bindings: &[
+                (Binding::Uniform, vk::ShaderStageFlags::VERTEX),
+                (Binding::Storage, vk::ShaderStageFlags::VERTEX),
+            ],
+            vertex_input: VertexInput::Position,
+            color_formats: &[vk::Format::R32_SFLOAT],
+            depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
+            blend: Blend::None,
+        },
+    )
+}
+
+/// Records every caster of the frame (inside a pass whose pipeline is bound).
+pub(crate) fn draw_casters(frame: &FrameInputs<'_>) {
+    for draw in frame.draws.iter().filter(|d| d.casts) {
+        draw.record(frame.ctx, frame.cmd);
+    }
+}
 
 /// Pass 1: linear light-space depth of the casters through the fitted spot frustum.
 pub struct ShadowMapPass {
@@ -76,21 +104,7 @@ pub struct ShadowMapPass {
 
 impl ShadowMapPass {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let pipeline = Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: "shadow_map",
-                vertex: shaders::SHADOW_MAP_DEPTH_VERT,
-                fragment: shaders::SHADOW_MAP_DEPTH_FRAG,
-                bindings: &[
-                    (Binding::Uniform, vk::ShaderStageFlags::VERTEX),
-                    (Binding::Storage, vk::ShaderStageFlags::VERTEX),
-                ],
-                vertex_input: VertexInput::Position,
-                color_formats: &[vk::Format::R32_SFLOAT],
-                depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
-            },
-        )?;
+        let pipeline = depth_pipeline(ctx)?;
         let usage = vk::BufferUsageFlags::UNIFORM_BUFFER;
         let light =
             match PerFrame::new(ctx, "light view", std::mem::size_of::<LightView>() as u64, FRAMES_IN_FLIGHT, usage) {
@@ -149,9 +163,7 @@ impl ShadowMapPass {
             cmd,
             &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
         );
-        for draw in frame.draws.iter().filter(|d| d.casts) {
-            draw.record(ctx, cmd);
-        }
+        draw_casters(frame);
         pass.end(ctx, cmd);
         transition(ctx, cmd, &mut [(map, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);

@@ -1,0 +1,216 @@
+//! CPU ground truth (DESIGN.md §2): a ray tracer over the very triangles the GPU draws, for the
+//! very camera rays the rasterizer samples. It finds each pixel's visible surface itself and
+//! estimates V there, so it is an independent check of the GPU `reference`.
+//!
+//! - [`TraceScene::visibility`]: V exactly as defined, by stratified shadow rays uniform in the
+//!   solid angle of the light sphere.
+//! - [`TraceScene::parker`]: Parker, Shirley & Smits' single-sample soft shadows.
+
+mod parker;
+
+use glam::{Vec2, Vec3};
+use parry3d::query::{Ray, RayCast};
+use parry3d::shape::{CompositeShapeRef, TriMesh};
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::geometry::{Aabb, CameraProjection};
+use crate::renderer::Surfaces;
+use crate::scene::{Light, Scene};
+
+/// A visibility image and the surfaces it was estimated at.
+#[derive(Clone, Debug)]
+pub struct TracedImage {
+    /// V in [0, 1], row-major, row 0 at the top.
+    pub visibility: Vec<f32>,
+    pub surfaces: Surfaces,
+}
+
+/// World-space triangles of one scene, with acceleration structures.
+pub struct TraceScene {
+    /// Every object and the ground: what camera rays hit.
+    everything: TriMesh,
+    /// Object index of each triangle of `everything` (the ground is the last object).
+    object_of: Vec<u32>,
+    receives: Vec<bool>,
+    /// The casters' triangles: what shadow rays test.
+    casters: Option<TriMesh>,
+    /// Object index of each caster triangle.
+    caster_object_of: Vec<u32>,
+    /// Casters that are exact spheres (centre, radius), by object index.
+    spheres: Vec<Option<(Vec3, f32)>>,
+    /// Offset of shadow-ray origins off their surface: relative to the scene's size, so it
+    /// holds at any scale.
+    epsilon: f32,
+}
+
+struct Triangles {
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+    object_of: Vec<u32>,
+}
+
+impl Triangles {
+    fn new() -> Self {
+        Triangles { positions: Vec::new(), indices: Vec::new(), object_of: Vec::new() }
+    }
+
+    fn push(&mut self, object: u32, positions: impl IntoIterator<Item = Vec3>, triangles: &[[u32; 3]]) {
+        let base = self.positions.len() as u32;
+        self.positions.extend(positions);
+        self.indices.extend(triangles.iter().map(|t| t.map(|i| base + i)));
+        self.object_of.extend(std::iter::repeat_n(object, triangles.len()));
+    }
+
+    fn mesh(self, what: &str) -> Result<Option<(TriMesh, Vec<u32>)>> {
+        if self.indices.is_empty() {
+            return Ok(None);
+        }
+        let mesh = TriMesh::new(self.positions, self.indices)
+            .map_err(|e| Error::Invalid(format!("ray tracer: cannot build the {what} mesh: {e:?}")))?;
+        Ok(Some((mesh, self.object_of)))
+    }
+}
+
+impl TraceScene {
+    pub fn new(scene: &Scene) -> Result<Self> {
+        let (mut all, mut casters) = (Triangles::new(), Triangles::new());
+        let mut receives = Vec::new();
+        let mut spheres = Vec::new();
+        let mut bounds = Aabb::EMPTY;
+        for (i, o) in scene.objects.iter().enumerate() {
+            let model = o.transform.matrix();
+            let world: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
+            bounds = bounds.union(&Aabb::from_points(world.iter().copied()));
+            all.push(i as u32, world.iter().copied(), &o.mesh.triangles);
+            if o.casts {
+                casters.push(i as u32, world, &o.mesh.triangles);
+            }
+            receives.push(o.receives);
+            spheres.push(o.sphere().filter(|_| o.casts));
+        }
+        if let Some(g) = &scene.ground {
+            let (h, s) = (g.height, g.half_size);
+            let corners = [Vec3::new(-s, h, -s), Vec3::new(s, h, -s), Vec3::new(s, h, s), Vec3::new(-s, h, s)];
+            bounds = bounds.union(&Aabb::from_points(corners));
+            all.push(receives.len() as u32, corners, &[[0, 2, 1], [0, 3, 2]]);
+            receives.push(true);
+        }
+        let Some((everything, object_of)) = all.mesh("scene")? else {
+            return Err(Error::Invalid("ray tracer: the scene has nothing to trace".into()));
+        };
+        let (casters, caster_object_of) = casters.mesh("caster")?.unzip();
+        let epsilon = 1e-5 * (bounds.max - bounds.min).length();
+        Ok(TraceScene {
+            everything,
+            object_of,
+            receives,
+            casters,
+            caster_object_of: caster_object_of.unwrap_or_default(),
+            spheres,
+            epsilon,
+        })
+    }
+
+    /// The surface each camera pixel sees (the ray through its centre) and `shade` evaluated
+    /// there from a point lifted off the surface towards the camera, in parallel over rows.
+    /// `progress` is told of every finished row.
+    pub fn render(
+        &self,
+        camera: &CameraProjection,
+        width: u32,
+        height: u32,
+        shade: impl Fn(Vec3, usize) -> f32 + Sync,
+        progress: &(dyn Fn() + Sync),
+    ) -> TracedImage {
+        let n = width as usize * height as usize;
+        let mut visibility = vec![1.0; n];
+        let mut depth = vec![f32::INFINITY; n];
+        let mut receives = vec![false; n];
+        visibility
+            .par_chunks_mut(width as usize)
+            .zip(depth.par_chunks_mut(width as usize))
+            .zip(receives.par_chunks_mut(width as usize))
+            .enumerate()
+            .for_each(|(y, ((v_row, d_row), r_row))| {
+                for x in 0..width as usize {
+                    let index = y * width as usize + x;
+                    let uv = Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
+                    let (origin, dir) = camera.ray(uv);
+                    let ray = Ray::new(origin, dir);
+                    let Some((tri, t)) = CompositeShapeRef(&self.everything).cast_local_ray(&ray, f32::MAX, false)
+                    else {
+                        continue;
+                    };
+                    let p = origin + dir * t;
+                    d_row[x] = (p - camera.position).dot(camera.forward);
+                    if !self.receives[self.object_of[tri as usize] as usize] {
+                        continue;
+                    }
+                    r_row[x] = true;
+                    let normal = self.everything.triangle(tri).normal().unwrap_or(-dir);
+                    let facing = if normal.dot(dir) > 0.0 { -normal } else { normal };
+                    v_row[x] = shade(p + facing * self.epsilon, index);
+                }
+                progress();
+            });
+        TracedImage { visibility, surfaces: Surfaces { depth, receives } }
+    }
+
+    /// Whether a caster crosses the segment from `origin` along unit `dir` for `length`.
+    fn blocked(&self, origin: Vec3, dir: Vec3, length: f32) -> bool {
+        self.casters.as_ref().is_some_and(|c| c.intersects_local_ray(&Ray::new(origin, dir), length))
+    }
+
+    /// V at `p`: the unblocked fraction of the light sphere's solid angle, from `samples`
+    /// directions uniform in that solid angle (a cone: cos θ uniform in [cos θ_max, 1]),
+    /// stratified in cos θ and spread in azimuth by the golden angle, with a per-`seed` jitter.
+    pub fn visibility(&self, p: Vec3, light: &Light, samples: usize, seed: u64) -> f32 {
+        let to_center = light.position - p;
+        let d = to_center.length();
+        if light.radius == 0.0 {
+            return if self.blocked(p, to_center / d, d) { 0.0 } else { 1.0 };
+        }
+        if d <= light.radius {
+            return 1.0; // inside the light: nothing can block all of it
+        }
+        let axis = to_center / d;
+        let (u, v) = axis.any_orthonormal_pair();
+        let cos_max = (1.0 - (light.radius / d).powi(2)).max(0.0).sqrt();
+        let c2 = d * d - light.radius * light.radius;
+        let mut rng = Rng::new(seed);
+        let phi0 = rng.next() * std::f32::consts::TAU;
+        let golden_angle = std::f32::consts::PI * (3.0 - 5.0f32.sqrt());
+        let lit = (0..samples)
+            .filter(|&i| {
+                let cos = 1.0 - (1.0 - cos_max) * (i as f32 + rng.next()) / samples as f32;
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let phi = phi0 + golden_angle * i as f32;
+                let dir = cos * axis + sin * (phi.cos() * u + phi.sin() * v);
+                // Distance to the near side of the sphere along `dir`.
+                let b = dir.dot(to_center);
+                let to_light = b - (b * b - c2).max(0.0).sqrt();
+                !self.blocked(p, dir, to_light)
+            })
+            .count();
+        lit as f32 / samples as f32
+    }
+}
+
+/// SplitMix64: a small, seedable generator (the tracer must give the same image every run).
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03)
+    }
+
+    /// Uniform in [0, 1).
+    fn next(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+}

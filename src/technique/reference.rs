@@ -1,0 +1,225 @@
+//! `reference`: ground truth on the GPU by Heckbert & Herf's accumulation ("Simulating Soft
+//! Shadows with Graphics Hardware", 1997): hard shadows from many points on the area light,
+//! averaged.
+//!
+//! V is defined (DESIGN.md §3) as the unblocked fraction of the solid angle the spherical light
+//! subtends at p. The points are spread uniformly in area over the cap of the sphere that any
+//! receiver in view can see ([`visible_cap`]); each one stands for a patch of the surface whose
+//! solid angle at p is max(0, cos θ_q)·dA / |p − q|², so the accumulation weights each sample by
+//! that per pixel and divides by the sum of the weights. Samples facing away from p weigh 0,
+//! which is what makes the estimate right far from the light's axis too.
+//!
+//! Batching: the shadow maps of up to 16 samples are rendered into the tiles of one atlas, then
+//! one full-screen pass adds all of their contributions at once (additive blending into an
+//! RG32F sum), so N samples cost N/16 accumulation passes instead of N.
+
+use ash::vk;
+use bytemuck::{Zeroable as _, cast_slice};
+use glam::{Vec3, Vec4};
+
+use super::knobs::{Knob, Params, TechniqueInfo};
+use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, depth_pipeline, draw_casters};
+use super::{FrameInputs, Technique, clear_visibility};
+use crate::error::Result;
+use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
+use crate::gpu::{
+    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, RenderPass, Target,
+    TargetDesc, ensure, fullscreen, shaders, transition,
+};
+use crate::gpu_types::{LightSample, LightView};
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    offline: true,
+    name: "reference",
+    summary: "ground truth: N hard shadows from points on the light, weighted by solid angle (Heckbert & Herf)",
+    knobs: &[
+        Knob {
+            name: "samples",
+            default: 256.0,
+            min: 1.0,
+            max: 4096.0,
+            integer: true,
+            help: "points on the light, one shadow map each",
+        },
+        Knob { default: 1024.0, max: 4096.0, ..SHADOW_MAP_SIZE },
+    ],
+};
+
+/// Tiles per atlas side at most: 16 shadow maps per accumulation pass.
+const MAX_TILES: u32 = 4;
+const SAMPLE_BYTES: u64 = std::mem::size_of::<LightSample>() as u64;
+const SUM_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
+/// Texel biases of the sample maps: the `shadow-map` defaults.
+const BIAS: [f32; 3] = [1.0, 1.0, 1.5];
+
+pub struct Reference {
+    depth: Pipeline,
+    accumulate: Pipeline,
+    resolve: Pipeline,
+    samples: Option<PerFrame>,
+    atlas: Option<Target>,
+    atlas_depth: Option<Target>,
+    sums: Option<Target>,
+}
+
+impl Reference {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let depth = depth_pipeline(ctx)?;
+        let sampled = Binding::Sampled;
+        let accumulate = Pipeline::fullscreen_blended(
+            ctx,
+            "accumulate",
+            shaders::REFERENCE_ACCUMULATE_FRAG,
+            &[Binding::Uniform, Binding::Storage, sampled, sampled, sampled],
+            SUM_FORMAT,
+            Blend::Add,
+        );
+        let accumulate = match accumulate {
+            Ok(p) => p,
+            Err(e) => {
+                depth.destroy(ctx);
+                return Err(e);
+            }
+        };
+        let format = crate::renderer::VISIBILITY_FORMAT;
+        match Pipeline::fullscreen(ctx, "resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], format) {
+            Ok(resolve) => {
+                Ok(Reference { depth, accumulate, resolve, samples: None, atlas: None, atlas_depth: None, sums: None })
+            }
+            Err(e) => {
+                depth.destroy(ctx);
+                accumulate.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// The light samples of this frame, each with its fitted frustum.
+    fn light_samples(frame: &FrameInputs<'_>, n: usize, size: u32) -> Vec<LightSample> {
+        let light = &frame.scene.light;
+        let casters: Vec<Vec3> = frame.draws.iter().filter(|d| d.casts).flat_map(|d| d.bounds.corners()).collect();
+        let aim = light.target.unwrap_or_else(|| Aabb::from_points(casters.iter().copied()).center());
+        // A point light has one point to sample.
+        let points = if light.radius > 0.0 {
+            let cap = visible_cap(light.position, light.radius, frame.receivers_in_view);
+            cap_points(light.position, light.radius, cap, n)
+        } else {
+            vec![light.position]
+        };
+        points
+            .into_iter()
+            .map(|q| {
+                let frustum = fit_spot_frustum(q, aim, &casters, frame.receivers_in_view);
+                let view = frustum.map_or(LightView::zeroed(), |f| LightView {
+                    view: f.view,
+                    view_proj: f.view_proj,
+                    extent: Vec4::from(f.window),
+                    bias: Vec4::new(BIAS[0], BIAS[1], BIAS[2], size as f32),
+                });
+                let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
+                LightSample { view, position: q.extend(has_map), pad: [Vec4::ZERO; 5] }
+            })
+            .collect()
+    }
+}
+
+/// `len` bytes of `base` from `offset`.
+fn sub_range(base: vk::DescriptorBufferInfo, offset: u64, len: u64) -> vk::DescriptorBufferInfo {
+    vk::DescriptorBufferInfo { buffer: base.buffer, offset: base.offset + offset, range: len }
+}
+
+impl Technique for Reference {
+    fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()> {
+        if !frame.draws.iter().any(|d| d.casts) || frame.receivers_in_view.is_empty() {
+            return clear_visibility(frame, visibility);
+        }
+        let ctx = frame.ctx;
+        let size = params.get("shadow_map_size") as u32;
+        let samples = Self::light_samples(frame, params.get("samples") as usize, size);
+
+        let bytes = samples.len() as u64 * SAMPLE_BYTES;
+        if self.samples.as_ref().is_none_or(|b| b.capacity() < bytes) {
+            // Grows only; the old buffer may still be read by the frame in flight.
+            ctx.wait_idle()?;
+            self.samples.take().into_iter().for_each(|b| b.destroy(ctx));
+            let usage = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+            self.samples = Some(PerFrame::new(ctx, "light samples", bytes, FRAMES_IN_FLIGHT, usage)?);
+        }
+        let buffer = self.samples.as_mut().expect("ensured");
+        buffer.write(frame.slot, cast_slice(&samples));
+        let base = buffer.range(frame.slot);
+
+        let tiles = MAX_TILES.min(ctx.info.max_image_dimension_2d / size).max(1);
+        let side = tiles * size;
+        ensure(ctx, &mut self.atlas, TargetDesc::color("reference atlas", vk::Format::R32_SFLOAT, side, side))?;
+        ensure(ctx, &mut self.atlas_depth, TargetDesc::depth("reference atlas depth", side, side))?;
+        let extent = visibility.extent();
+        ensure(ctx, &mut self.sums, TargetDesc::color("reference sums", SUM_FORMAT, extent.width, extent.height))?;
+        let (atlas, atlas_depth, sums) = (
+            self.atlas.as_mut().expect("ensured"),
+            self.atlas_depth.as_mut().expect("ensured"),
+            self.sums.as_mut().expect("ensured"),
+        );
+
+        let cmd = frame.cmd;
+        frame.timer.begin(ctx, cmd, "accumulate");
+        let per_batch = (tiles * tiles) as usize;
+        for (b, batch) in samples.chunks(per_batch).enumerate() {
+            let first = (b * per_batch) as u64 * SAMPLE_BYTES;
+            // The previous batch's maps have been summed: discard them.
+            transition(ctx, cmd, &mut [(atlas, Access::COLOR_WRITE, true), (atlas_depth, Access::DEPTH_WRITE, true)]);
+            let pass = RenderPass::begin(
+                ctx,
+                cmd,
+                &[Attachment::clear_color(atlas, [EMPTY_DEPTH; 4])],
+                Some(Attachment::clear_depth(atlas_depth, 1.0)),
+            );
+            for (i, sample) in batch.iter().enumerate().filter(|(_, s)| s.position.w > 0.0) {
+                let i = i as u32;
+                let offset = vk::Offset2D { x: ((i % tiles) * size) as i32, y: ((i / tiles) * size) as i32 };
+                pass.set_area(ctx, cmd, vk::Rect2D { offset, extent: vk::Extent2D { width: size, height: size } });
+                let light =
+                    sub_range(base, first + i as u64 * SAMPLE_BYTES, std::mem::size_of_val(&sample.view) as u64);
+                self.depth.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Buffer(frame.objects)]);
+                draw_casters(frame);
+            }
+            pass.end(ctx, cmd);
+
+            // The first batch starts the sums; later ones add to them.
+            transition(ctx, cmd, &mut [(atlas, Access::FRAGMENT_READ, false), (sums, Access::COLOR_WRITE, b == 0)]);
+            let target =
+                if b == 0 { Attachment::clear_color(sums, [0.0; 4]) } else { Attachment { target: sums, clear: None } };
+            let pass = RenderPass::begin(ctx, cmd, &[target], None);
+            self.accumulate.bind(
+                ctx,
+                cmd,
+                &[
+                    Descriptor::Buffer(frame.globals),
+                    Descriptor::Buffer(sub_range(base, first, batch.len() as u64 * SAMPLE_BYTES)),
+                    Descriptor::Image(frame.depth),
+                    Descriptor::Image(frame.normal),
+                    Descriptor::Image(atlas),
+                ],
+            );
+            unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+            pass.end(ctx, cmd);
+        }
+        transition(ctx, cmd, &mut [(sums, Access::FRAGMENT_READ, false)]);
+        frame.timer.end(ctx, cmd);
+
+        frame.timer.begin(ctx, cmd, "resolve");
+        transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
+        fullscreen(ctx, cmd, &self.resolve, visibility, &[Descriptor::Image(sums)]);
+        frame.timer.end(ctx, cmd);
+        Ok(())
+    }
+
+    fn destroy(self: Box<Self>, ctx: &Context) {
+        let this = *self;
+        for p in [this.depth, this.accumulate, this.resolve] {
+            p.destroy(ctx);
+        }
+        this.samples.into_iter().for_each(|b| b.destroy(ctx));
+        this.atlas.into_iter().chain(this.atlas_depth).chain(this.sums).for_each(|t| t.destroy(ctx));
+    }
+}

@@ -1,0 +1,113 @@
+//! The CPU ray-traced techniques, `raytrace` (ground truth) and `parker` (Parker, Shirley &
+//! Smits' single-sample soft shadows): [`TraceScene`] computes V for the frame's camera pixels,
+//! then one copy uploads it into the visibility image, so the composite, the readback and the
+//! metrics treat them like any GPU technique.
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use ash::vk;
+
+use super::knobs::{Knob, Params, TechniqueInfo};
+use super::{FrameInputs, Technique};
+use crate::error::Result;
+use crate::gpu::{Context, FRAMES_IN_FLIGHT, PerFrame, Target, copy_to_target};
+use crate::reference::TraceScene;
+use crate::renderer::Surfaces;
+
+pub const RAYTRACE: TechniqueInfo = TechniqueInfo {
+    offline: true,
+    name: "raytrace",
+    summary: "ground truth on the CPU: stratified shadow rays uniform in the light's solid angle",
+    knobs: &[Knob {
+        name: "samples",
+        default: 1024.0,
+        min: 1.0,
+        max: 65536.0,
+        integer: true,
+        help: "shadow rays per pixel",
+    }],
+};
+
+pub const PARKER: TechniqueInfo = TechniqueInfo {
+    offline: true,
+    name: "parker",
+    summary: "Parker, Shirley & Smits: one shadow ray per pixel past soft-edged occluders (CPU)",
+    knobs: &[],
+};
+
+/// Shadow rays in a frame above which a progress bar is worth showing.
+const LONG_FRAME_RAYS: usize = 20_000_000;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    Exact,
+    Parker,
+}
+
+pub struct Traced {
+    method: Method,
+    staging: Option<PerFrame>,
+    surfaces: Option<Surfaces>,
+}
+
+impl Traced {
+    pub fn new(method: Method) -> Self {
+        Traced { method, staging: None, surfaces: None }
+    }
+}
+
+impl Technique for Traced {
+    fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()> {
+        let ctx = frame.ctx;
+        let extent = visibility.extent();
+        let (w, h) = (extent.width, extent.height);
+        let scene = TraceScene::new(frame.scene)?;
+        let light = &frame.scene.light;
+        let samples = if self.method == Method::Exact { params.get("samples") as usize } else { 1 };
+
+        // Indicatif hides the bar when stderr is not a terminal.
+        let bar = (w as usize * h as usize * samples > LONG_FRAME_RAYS)
+            .then(|| indicatif::ProgressBar::new(h as u64).with_message(format!("{} rows", params.technique.name)));
+        let rows = AtomicUsize::new(0);
+        let progress = || {
+            let done = rows.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(bar) = &bar {
+                bar.set_position(done as u64);
+            }
+        };
+        let image = match self.method {
+            Method::Exact => {
+                scene.render(frame.camera, w, h, |p, i| scene.visibility(p, light, samples, i as u64), &progress)
+            }
+            Method::Parker => scene.render(frame.camera, w, h, |p, _| scene.parker(p, light), &progress),
+        };
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
+
+        let texels: Vec<u16> = image.visibility.iter().map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16).collect();
+        let bytes: &[u8] = bytemuck::cast_slice(&texels);
+        if self.staging.as_ref().is_none_or(|s| s.capacity() < bytes.len() as u64) {
+            // Grows only; the old buffer may still be read by the frame in flight.
+            ctx.wait_idle()?;
+            self.staging.take().into_iter().for_each(|s| s.destroy(ctx));
+            let usage = vk::BufferUsageFlags::TRANSFER_SRC;
+            self.staging = Some(PerFrame::new(ctx, "traced visibility", bytes.len() as u64, FRAMES_IN_FLIGHT, usage)?);
+        }
+        let staging = self.staging.as_mut().expect("ensured");
+        staging.write(frame.slot, bytes);
+        frame.timer.begin(ctx, frame.cmd, "upload");
+        copy_to_target(ctx, frame.cmd, staging.range(frame.slot), visibility);
+        frame.timer.end(ctx, frame.cmd);
+        self.surfaces = Some(image.surfaces);
+        Ok(())
+    }
+
+    fn traced_surfaces(&self) -> Option<&Surfaces> {
+        self.surfaces.as_ref()
+    }
+
+    fn destroy(self: Box<Self>, ctx: &Context) {
+        self.staging.into_iter().for_each(|s| s.destroy(ctx));
+    }
+}
