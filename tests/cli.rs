@@ -85,3 +85,37 @@ fn techniques_lists_knobs_with_defaults() {
         "{text}"
     );
 }
+
+#[test]
+fn compare_prints_metrics_as_json_and_writes_a_difference_image() {
+    let diff = std::env::temp_dir().join(format!("softshadow-diff-{}.png", std::process::id()));
+    let out = softshadow()
+        .args(["compare", "scenes/plate.toml", "--technique", "shadow-map", "--against", "raytrace"])
+        .args(["--against-set", "samples=64", "--width", "64", "--height", "48", "--frames", "2", "--json"])
+        .arg("--diff")
+        .arg(&diff)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((j["technique"].as_str(), j["against"].as_str()), (Some("shadow-map"), Some("raytrace")));
+    let m = &j["metrics"];
+    // A hard shadow against a soft one: wrong in the penumbra, right elsewhere.
+    assert!(m["pixels"].as_u64().unwrap() > 1000);
+    assert!(m["penumbra_rmse"].as_f64().unwrap() > m["rmse"].as_f64().unwrap());
+    assert!(m["rmse"].as_f64().unwrap() < 0.2);
+    assert_eq!(j["timings"]["frames"], 2);
+    let img = image::open(&diff).unwrap();
+    assert_eq!((img.width(), img.height()), (64, 48));
+    std::fs::remove_file(diff).ok();
+}
+
+#[test]
+fn compare_refuses_a_non_reference_ground_truth() {
+    let out = softshadow()
+        .args(["compare", "scenes/plate.toml", "--technique", "reference", "--against", "parker"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("parker"));
+}

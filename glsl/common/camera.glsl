@@ -16,7 +16,7 @@ vec3 world_position(mat4 inv_view_proj, vec2 uv, float depth) {
 // src/renderer/mod.rs): 0 receives no shadow, 0.5 receives, 1 receives and casts.
 struct Surface {
     vec3 p;        // world position
-    vec3 n;        // unit normal on the side facing the camera
+    vec3 n;        // the facet's unit normal, on the side facing the camera
     bool receives; // false: V = 1 here (also where no surface is seen)
     bool casts;    // the surface belongs to a caster, so it blocks light arriving from behind it
 };

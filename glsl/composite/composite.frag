@@ -5,7 +5,7 @@
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform sampler2D camera_depth;
-layout(set = 0, binding = 2) uniform sampler2D camera_normal;
+layout(set = 0, binding = 2) uniform sampler2D camera_shading;
 layout(set = 0, binding = 3) uniform sampler2D camera_albedo;
 layout(set = 0, binding = 4) uniform sampler2D visibility;
 
@@ -20,7 +20,7 @@ void main() {
         return;
     }
     vec3 p = world_position(frame.inv_view_proj, in_uv, depth);
-    vec3 n = normalize(texelFetch(camera_normal, pixel, 0).xyz);
+    vec3 n = normalize(texelFetch(camera_shading, pixel, 0).xyz * 2.0 - 1.0);
     vec3 albedo = texelFetch(camera_albedo, pixel, 0).rgb;
     float v = texelFetch(visibility, pixel, 0).r;
     float lambert = max(dot(n, normalize(frame.light.xyz - p)), 0.0);

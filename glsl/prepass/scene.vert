@@ -9,11 +9,13 @@ layout(location = 1) in vec3 in_normal;
 
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec4 out_albedo;
+layout(location = 2) out vec3 out_world;
 
 void main() {
     ObjectData object = objects[gl_InstanceIndex];
     vec4 world = object.model * vec4(in_position, 1.0);
     out_normal = mat3(object.normal_matrix) * in_normal;
     out_albedo = object.albedo;
+    out_world = world.xyz;
     gl_Position = frame.view_proj * world;
 }

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::{Metrics, TimingReport, save_difference};
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, TECHNIQUES, knobs};
+use softshadow::technique::{Params, TECHNIQUES, knobs, reference, traced};
 use softshadow::{Capture, Engine, FrameSettings};
 
 /// Frames rendered before timing starts (pipelines warm, caches filled).
@@ -228,7 +228,7 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
 fn compare(args: &CompareArgs) -> Result<()> {
     let (scene, settings) = load(&args.what)?;
     let against = knobs::find(&args.against)?;
-    if !against.offline {
+    if ![reference::INFO.name, traced::RAYTRACE.name].contains(&against.name) {
         bail!("--against takes a ground truth (reference or raytrace), not `{}`", against.name);
     }
     let mut truth = FrameSettings { params: Params::defaults(against), ..settings.clone() };

@@ -39,6 +39,8 @@ pub struct TraceScene {
     caster_object_of: Vec<u32>,
     /// Casters that are exact spheres (centre, radius), by object index.
     spheres: Vec<Option<(Vec3, f32)>>,
+    /// Which objects cast, by object index.
+    casts: Vec<bool>,
     /// Offset of shadow-ray origins off their surface: relative to the scene's size, so it
     /// holds at any scale.
     epsilon: f32,
@@ -77,6 +79,7 @@ impl TraceScene {
         let (mut all, mut casters) = (Triangles::new(), Triangles::new());
         let mut receives = Vec::new();
         let mut spheres = Vec::new();
+        let mut casts = Vec::new();
         let mut bounds = Aabb::EMPTY;
         for (i, o) in scene.objects.iter().enumerate() {
             let model = o.transform.matrix();
@@ -87,6 +90,7 @@ impl TraceScene {
                 casters.push(i as u32, world, &o.mesh.triangles);
             }
             receives.push(o.receives);
+            casts.push(o.casts);
             spheres.push(o.sphere().filter(|_| o.casts));
         }
         if let Some(g) = &scene.ground {
@@ -95,6 +99,7 @@ impl TraceScene {
             bounds = bounds.union(&Aabb::from_points(corners));
             all.push(receives.len() as u32, corners, &[[0, 2, 1], [0, 3, 2]]);
             receives.push(true);
+            casts.push(false);
         }
         let Some((everything, object_of)) = all.mesh("scene")? else {
             return Err(Error::Invalid("ray tracer: the scene has nothing to trace".into()));
@@ -108,31 +113,35 @@ impl TraceScene {
             casters,
             caster_object_of: caster_object_of.unwrap_or_default(),
             spheres,
+            casts,
             epsilon,
         })
     }
 
     /// The surface each camera pixel sees (the ray through its centre) and `shade` evaluated
-    /// there from a point lifted off the surface towards the camera, in parallel over rows.
-    /// `progress` is told of every finished row.
+    /// there, in parallel over rows. `shade` gets the point lifted off the surface towards the
+    /// camera, the [`Surface`] and the pixel's index. `progress` is told of every finished row.
     pub fn render(
         &self,
         camera: &CameraProjection,
         width: u32,
         height: u32,
-        shade: impl Fn(Vec3, usize) -> f32 + Sync,
+        shade: impl Fn(Surface, usize) -> f32 + Sync,
         progress: &(dyn Fn() + Sync),
     ) -> TracedImage {
         let n = width as usize * height as usize;
         let mut visibility = vec![1.0; n];
         let mut depth = vec![f32::INFINITY; n];
+        let mut normal = vec![Vec3::ZERO; n];
         let mut receives = vec![false; n];
+        let row = width as usize;
         visibility
-            .par_chunks_mut(width as usize)
-            .zip(depth.par_chunks_mut(width as usize))
-            .zip(receives.par_chunks_mut(width as usize))
+            .par_chunks_mut(row)
+            .zip(depth.par_chunks_mut(row))
+            .zip(normal.par_chunks_mut(row))
+            .zip(receives.par_chunks_mut(row))
             .enumerate()
-            .for_each(|(y, ((v_row, d_row), r_row))| {
+            .for_each(|(y, (((v_row, d_row), n_row), r_row))| {
                 for x in 0..width as usize {
                     let index = y * width as usize + x;
                     let uv = Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
@@ -144,17 +153,20 @@ impl TraceScene {
                     };
                     let p = origin + dir * t;
                     d_row[x] = (p - camera.position).dot(camera.forward);
+                    let facet = self.everything.triangle(tri).normal().unwrap_or(-dir);
+                    let facing = if facet.dot(dir) > 0.0 { -facet } else { facet };
+                    n_row[x] = facing;
                     if !self.receives[self.object_of[tri as usize] as usize] {
                         continue;
                     }
                     r_row[x] = true;
-                    let normal = self.everything.triangle(tri).normal().unwrap_or(-dir);
-                    let facing = if normal.dot(dir) > 0.0 { -normal } else { normal };
-                    v_row[x] = shade(p + facing * self.epsilon, index);
+                    let caster = self.casts[self.object_of[tri as usize] as usize];
+                    let surface = Surface { point: p + facing * self.epsilon, solid_side: caster.then_some(facing) };
+                    v_row[x] = shade(surface, index);
                 }
                 progress();
             });
-        TracedImage { visibility, surfaces: Surfaces { depth, receives } }
+        TracedImage { visibility, surfaces: Surfaces { depth, normal, receives } }
     }
 
     /// Whether a caster crosses the segment from `origin` along unit `dir` for `length`.
@@ -162,14 +174,22 @@ impl TraceScene {
         self.casters.as_ref().is_some_and(|c| c.intersects_local_ray(&Ray::new(origin, dir), length))
     }
 
-    /// V at `p`: the unblocked fraction of the light sphere's solid angle, from `samples`
+    /// Whether a shadow ray from `s` along unit `dir` is blocked within `length`: by the
+    /// caster the surface belongs to when `dir` leaves on its solid side (exactly, with no
+    /// dependence on the lift off the surface), else by any caster on the way.
+    fn shadow_ray_blocked(&self, s: Surface, dir: Vec3, length: f32) -> bool {
+        s.solid_side.is_some_and(|n| n.dot(dir) <= 0.0) || self.blocked(s.point, dir, length)
+    }
+
+    /// V at `s`: the unblocked fraction of the light sphere's solid angle, from `samples`
     /// directions uniform in that solid angle (a cone: cos θ uniform in [cos θ_max, 1]),
     /// stratified in cos θ and spread in azimuth by the golden angle, with a per-`seed` jitter.
-    pub fn visibility(&self, p: Vec3, light: &Light, samples: usize, seed: u64) -> f32 {
+    pub fn visibility(&self, s: Surface, light: &Light, samples: usize, seed: u64) -> f32 {
+        let p = s.point;
         let to_center = light.position - p;
         let d = to_center.length();
         if light.radius == 0.0 {
-            return if self.blocked(p, to_center / d, d) { 0.0 } else { 1.0 };
+            return if self.shadow_ray_blocked(s, to_center / d, d) { 0.0 } else { 1.0 };
         }
         if d <= light.radius {
             return 1.0; // inside the light: nothing can block all of it
@@ -190,10 +210,27 @@ impl TraceScene {
                 // Distance to the near side of the sphere along `dir`.
                 let b = dir.dot(to_center);
                 let to_light = b - (b * b - c2).max(0.0).sqrt();
-                !self.blocked(p, dir, to_light)
+                !self.shadow_ray_blocked(s, dir, to_light)
             })
             .count();
         lit as f32 / samples as f32
+    }
+}
+
+/// A point where V is estimated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Surface {
+    /// On the surface, lifted a hair off it towards the viewer.
+    pub point: Vec3,
+    /// For a caster's own surface, its facet normal on the viewer's side: light from behind
+    /// the facet's plane is blocked by the caster itself. `None` for surfaces that cast nothing.
+    pub solid_side: Option<Vec3>,
+}
+
+impl Surface {
+    /// A point in free space, or on a surface that casts no shadow (the ground).
+    pub fn free(point: Vec3) -> Self {
+        Surface { point, solid_side: None }
     }
 }
 

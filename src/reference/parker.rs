@@ -17,7 +17,7 @@ use glam::{Vec2, Vec3};
 use parry3d::bounding_volume::Aabb as ParryAabb;
 use parry3d::partitioning::TraversalAction;
 
-use super::TraceScene;
+use super::{Surface, TraceScene};
 use crate::scene::Light;
 
 /// The Bernstein interpolant of §3.
@@ -118,23 +118,27 @@ fn distance_to_triangle(p: [Vec2; 3]) -> (f32, [f32; 3]) {
 }
 
 impl TraceScene {
-    /// Parker et al.'s attenuation at `p`: one ray to the light's centre.
-    pub fn parker(&self, p: Vec3, light: &Light) -> f32 {
+    /// Parker et al.'s attenuation at `s`: one ray to the light's centre.
+    pub fn parker(&self, s: Surface, light: &Light) -> f32 {
+        let p = s.point;
         let to_light = light.position - p;
         let length = to_light.length();
         if length <= light.radius {
             return 1.0;
         }
         let dir = to_light / length;
+        if s.solid_side.is_some_and(|n| n.dot(dir) <= 0.0) {
+            return 0.0; // the caster's own surface faces away from the light
+        }
         let (u, v) = dir.any_orthonormal_pair();
         let ray = ShadowRay { origin: p, dir, length, diameter: 2.0 * light.radius, u, v };
-        let mut s = 1.0f32;
+        let mut v = 1.0f32;
         for (center, radius) in self.spheres.iter().flatten() {
-            s = s.min(ray.sphere(*center, *radius));
+            v = v.min(ray.sphere(*center, *radius));
         }
-        let Some(casters) = &self.casters else { return s };
+        let Some(casters) = &self.casters else { return v };
         casters.bvh().traverse(|node| {
-            if s == 0.0 {
+            if v == 0.0 {
                 return TraversalAction::EarlyExit;
             }
             if !ray.may_reach(&node.aabb()) {
@@ -144,12 +148,12 @@ impl TraceScene {
                 // Exact spheres were handled above; their tessellation must not count twice.
                 if self.spheres[self.caster_object_of[tri as usize] as usize].is_none() {
                     let t = casters.triangle(tri);
-                    s = s.min(ray.triangle([t.a, t.b, t.c]));
+                    v = v.min(ray.triangle([t.a, t.b, t.c]));
                 }
             }
             TraversalAction::Continue
         });
-        s
+        v
     }
 }
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use ash::vk;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use super::CameraTargets;
 use crate::error::{Error, Result};
@@ -54,12 +54,31 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
 pub struct Surfaces {
     /// Distance along the camera's forward axis; infinite where no surface is seen.
     pub depth: Vec<f32>,
+    /// The facet's unit normal on the camera's side (zero where no surface is seen).
+    pub normal: Vec<Vec3>,
     /// The surface receives shadows (V means something there).
     pub receives: Vec<bool>,
 }
 
 /// 0.25 as an IEEE half float: shadow roles above it receive (`shadow_role` in mod.rs).
 const HALF_QUARTER: u16 = 0x3400;
+
+/// An IEEE half float's value.
+fn half_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let (exponent, mantissa) = ((h >> 10) & 0x1F, (h & 0x3FF) as f32);
+    sign * match exponent {
+        0 => mantissa * 2f32.powi(-24),
+        31 => {
+            if mantissa == 0.0 {
+                f32::INFINITY
+            } else {
+                f32::NAN
+            }
+        }
+        e => (1.0 + mantissa / 1024.0) * 2f32.powi(e as i32 - 15),
+    }
+}
 
 /// The image point (0..1, row 0 at the top) at the centre of pixel `index` of a row-major image.
 pub fn pixel_uv(index: usize, width: u32, height: u32) -> Vec2 {
@@ -100,11 +119,19 @@ impl Capture {
                 if d > 0.0 { camera.view_depth(pixel_uv(i, width, height), d) } else { f32::INFINITY }
             })
             .collect();
+        let halfs = |b: &[u8]| -> [u16; 4] { std::array::from_fn(|i| u16::from_ne_bytes([b[2 * i], b[2 * i + 1]])) };
+        let normal = parts[2]
+            .chunks_exact(8)
+            .map(|b| {
+                let [x, y, z, _] = halfs(b).map(half_to_f32);
+                Vec3::new(x, y, z)
+            })
+            .collect();
         // The normal target's alpha (a half float, 0, 0.5 or 1) is the shadow role; positive
         // halfs order like their bits.
-        let receives = parts[2].chunks_exact(8).map(|b| u16::from_ne_bytes([b[6], b[7]]) > HALF_QUARTER).collect();
+        let receives = parts[2].chunks_exact(8).map(|b| halfs(b)[3] > HALF_QUARTER).collect();
         let visibility = parts[3].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect();
-        Capture { width, height, color, visibility, surfaces: Surfaces { depth, receives } }
+        Capture { width, height, color, visibility, surfaces: Surfaces { depth, normal, receives } }
     }
 
     /// V at pixel (x, y) in [0, 1].
@@ -122,5 +149,18 @@ impl Capture {
         let img = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(self.width, self.height, self.visibility.clone())
             .expect("buffer matches its size");
         img.save(path).map_err(|source| Error::Image { path: path.into(), source })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::half_to_f32;
+
+    #[test]
+    fn half_floats_decode() {
+        for (bits, value) in [(0x3C00, 1.0), (0x3800, 0.5), (0xC000, -2.0), (0x0000, 0.0), (0x0001, 2f32.powi(-24))] {
+            assert_eq!(half_to_f32(bits), value);
+        }
+        assert_eq!(half_to_f32(0x7BFF), 65504.0);
     }
 }

@@ -17,7 +17,7 @@ use gpu_allocator::MemoryLocation;
 pub use capture::{Capture, Surfaces, pixel_uv};
 pub use draw::Draw;
 use draw::MeshCache;
-use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass};
+use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
 
 use crate::error::Result;
 use crate::geometry::{Aabb, CameraProjection, Hexahedron, intersection_points};
@@ -64,7 +64,10 @@ pub struct FrameTimings {
 /// The camera-sized targets every technique shares.
 pub struct CameraTargets {
     pub depth: Target,
+    /// Facet normal (facing the camera) and shadow role: what techniques read.
     pub normal: Target,
+    /// Interpolated normal: what the composite shades with.
+    pub shading: Target,
     pub albedo: Target,
     pub visibility: Target,
     pub color: Target,
@@ -77,6 +80,7 @@ impl CameraTargets {
         let descs = [
             TargetDesc::depth("camera depth", w, h).usage(sampled | readback),
             TargetDesc::color("camera normal", NORMAL_FORMAT, w, h).usage(readback),
+            TargetDesc::color("camera shading normal", SHADING_FORMAT, w, h),
             TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
             // CPU techniques (`raytrace`, `parker`) copy V in.
             TargetDesc::color("visibility", VISIBILITY_FORMAT, w, h)
@@ -93,8 +97,9 @@ impl CameraTargets {
                 }
             }
         }
-        let [depth, normal, albedo, visibility, color] = <[Target; 5]>::try_from(made).ok().expect("five targets");
-        Ok(CameraTargets { depth, normal, albedo, visibility, color })
+        let [depth, normal, shading, albedo, visibility, color] =
+            <[Target; 6]>::try_from(made).ok().expect("six targets");
+        Ok(CameraTargets { depth, normal, shading, albedo, visibility, color })
     }
 
     fn extent(&self) -> vk::Extent2D {
@@ -102,7 +107,7 @@ impl CameraTargets {
     }
 
     fn destroy(self, ctx: &Context) {
-        for t in [self.depth, self.normal, self.albedo, self.visibility, self.color] {
+        for t in [self.depth, self.normal, self.shading, self.albedo, self.visibility, self.color] {
             t.destroy(ctx);
         }
     }

@@ -9,11 +9,14 @@ use crate::gpu::{
     VertexInput, fullscreen, shaders, transition,
 };
 
+/// Facet normal + shadow role, read by the techniques.
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// Interpolated normal as n/2 + 1/2, read by the composite.
+pub const SHADING_FORMAT: vk::Format = vk::Format::A2B10G10R10_UNORM_PACK32;
 pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 
-/// Camera prepass: reverse-Z depth, world normal with the receives flag, albedo.
+/// Camera prepass: reverse-Z depth, facet normal with the shadow role, shading normal, albedo.
 pub struct Prepass {
     pipeline: Pipeline,
 }
@@ -21,15 +24,16 @@ pub struct Prepass {
 impl Prepass {
     pub fn new(ctx: &Context) -> Result<Self> {
         let vertex = vk::ShaderStageFlags::VERTEX;
+        let both = vertex | vk::ShaderStageFlags::FRAGMENT;
         let pipeline = Pipeline::new(
             ctx,
             &PipelineDesc {
                 name: "prepass",
                 vertex: shaders::PREPASS_SCENE_VERT,
                 fragment: shaders::PREPASS_SCENE_FRAG,
-                bindings: &[(Binding::Uniform, vertex), (Binding::Storage, vertex)],
+                bindings: &[(Binding::Uniform, both), (Binding::Storage, vertex)],
                 vertex_input: VertexInput::PositionNormal,
-                color_formats: &[NORMAL_FORMAT, ALBEDO_FORMAT],
+                color_formats: &[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT],
                 // Reverse Z: nearer is greater.
                 depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),
                 blend: Blend::None,
@@ -55,13 +59,18 @@ impl Prepass {
             &mut [
                 (&mut t.depth, Access::DEPTH_WRITE, true),
                 (&mut t.normal, Access::COLOR_WRITE, true),
+                (&mut t.shading, Access::COLOR_WRITE, true),
                 (&mut t.albedo, Access::COLOR_WRITE, true),
             ],
         );
         let pass = RenderPass::begin(
             ctx,
             cmd,
-            &[Attachment::clear_color(&t.normal, [0.0; 4]), Attachment::clear_color(&t.albedo, [0.0; 4])],
+            &[
+                Attachment::clear_color(&t.normal, [0.0; 4]),
+                Attachment::clear_color(&t.shading, [0.0; 4]),
+                Attachment::clear_color(&t.albedo, [0.0; 4]),
+            ],
             Some(Attachment::clear_depth(&t.depth, 0.0)),
         );
         self.pipeline.bind(ctx, cmd, &inputs.map(Descriptor::Buffer));
@@ -75,6 +84,7 @@ impl Prepass {
             &mut [
                 (&mut t.depth, Access::DEPTH_FRAGMENT_READ, false),
                 (&mut t.normal, Access::FRAGMENT_READ, false),
+                (&mut t.shading, Access::FRAGMENT_READ, false),
                 (&mut t.albedo, Access::FRAGMENT_READ, false),
             ],
         );
@@ -120,7 +130,7 @@ impl Composite {
             &[
                 Descriptor::Buffer(globals),
                 Descriptor::Image(&t.depth),
-                Descriptor::Image(&t.normal),
+                Descriptor::Image(&t.shading),
                 Descriptor::Image(&t.albedo),
                 Descriptor::Image(&t.visibility),
             ],

@@ -1,0 +1,223 @@
+//! Ground truth checked against analytic visibility, and the GPU reference against the CPU
+//! tracer: the half-plane penumbra, the overlap of two spherical caps, convergence with the
+//! number of light samples, Parker et al.'s single-sample shadows.
+
+mod common;
+
+use std::f64::consts::PI;
+
+use common::{engine, finish, scene, settings};
+use glam::Vec3;
+use softshadow::measure::Metrics;
+use softshadow::reference::{Surface, TraceScene};
+use softshadow::scene::Scene;
+use softshadow::{Capture, Engine};
+
+/// A plate covering x < 0 (40 m square, a half-plane for any light footprint near x = 0) at
+/// height `h` over the ground, under a light of radius `r` at height `big_h` above x = 0.
+fn half_plane(h: f32, big_h: f32, r: f32) -> Scene {
+    scene(&format!(
+        r#"
+[camera]
+position = [0.0, 6.0, 6.0]
+target = [0.0, 0.0, 0.0]
+fov_y_deg = 40.0
+[light]
+position = [0.0, {big_h}, 0.0]
+radius = {r}
+[ground]
+height = 0.0
+half_size = 30.0
+[[object]]
+shape = "plate"
+size = [40.0, 0.0, 40.0]
+position = [-20.0, {h}, 0.0]
+"#
+    ))
+}
+
+/// V under a half-plane edge (the light seen as a disk, its footprint cut by the edge): the
+/// circular-segment area fraction.
+fn half_plane_v(x: f64, h: f64, big_h: f64, r: f64) -> f64 {
+    let u = (-x * (big_h - h) / (h * r)).clamp(-1.0, 1.0);
+    (u.acos() - u * (1.0 - u * u).sqrt()) / PI
+}
+
+/// Solid angle of the intersection of two spherical caps of angular radii `a` and `b` whose
+/// centres are `g` apart (Tovchigrechko & Vakser 2001).
+fn cap_overlap(a: f64, b: f64, g: f64) -> f64 {
+    if g >= a + b {
+        return 0.0;
+    }
+    if g <= (a - b).abs() {
+        return 2.0 * PI * (1.0 - a.min(b).cos());
+    }
+    let (ca, cb, cg, sa, sb, sg) = (a.cos(), b.cos(), g.cos(), a.sin(), b.sin(), g.sin());
+    2.0 * (PI
+        - ((cg - ca * cb) / (sa * sb)).clamp(-1.0, 1.0).acos()
+        - ca * ((cb - cg * ca) / (sg * sa)).clamp(-1.0, 1.0).acos()
+        - cb * ((ca - cg * cb) / (sg * sb)).clamp(-1.0, 1.0).acos())
+}
+
+/// V at `p` under a light sphere (`light`, `r`) partly hidden by a ball (`ball`, `rb`).
+fn sphere_v(p: Vec3, light: Vec3, r: f32, ball: Vec3, rb: f32) -> f64 {
+    let (to_l, to_b) = ((light - p).as_dvec3(), (ball - p).as_dvec3());
+    let a = (r as f64 / to_l.length()).asin();
+    let b = (rb as f64 / to_b.length()).asin();
+    let g = to_l.angle_between(to_b);
+    1.0 - cap_overlap(a, b, g) / (2.0 * PI * (1.0 - a.cos()))
+}
+
+fn sphere_scene(light: Vec3, r: f32, ball: Vec3, rb: f32) -> Scene {
+    scene(&format!(
+        r#"
+[camera]
+position = [0.0, 5.0, 7.0]
+target = [0.0, 0.0, 0.0]
+fov_y_deg = 40.0
+[light]
+position = [{}, {}, {}]
+radius = {r}
+[ground]
+height = 0.0
+[[object]]
+shape = "sphere"
+radius = {rb}
+position = [{}, {}, {}]
+"#,
+        light.x, light.y, light.z, ball.x, ball.y, ball.z
+    ))
+}
+
+#[test]
+fn raytrace_matches_the_half_plane_penumbra() {
+    let (h, big_h, r) = (2.0, 20.0, 1.0);
+    let s = half_plane(h, big_h, r);
+    let tracer = TraceScene::new(&s).unwrap();
+    let half_width = h * r / (big_h - h);
+    for i in 0..=40 {
+        let x = (i as f32 / 20.0 - 1.0) * 1.5 * half_width;
+        for z in [0.0, 0.7] {
+            let v = tracer.visibility(Surface::free(Vec3::new(x, 0.0, z)), &s.light, 1024, i) as f64;
+            let expected = half_plane_v(x as f64, h as f64, big_h as f64, r as f64);
+            assert!((v - expected).abs() < 0.01, "x = {x}, z = {z}: traced {v}, analytic {expected}");
+        }
+    }
+}
+
+#[test]
+fn raytrace_matches_the_overlap_of_two_spherical_caps() {
+    let (light, r, ball, rb) = (Vec3::new(1.0, 8.0, 0.5), 0.8, Vec3::new(0.0, 1.5, 0.0), 0.5);
+    let s = sphere_scene(light, r, ball, rb);
+    let tracer = TraceScene::new(&s).unwrap();
+    // The UV sphere (24 segments, 16 rings) lies between the ball and the ball shrunk to its
+    // faces' nearest distance, and V only grows as the occluder shrinks.
+    let inner = rb * (std::f32::consts::PI / 24.0).cos() * (std::f32::consts::PI / 32.0).cos();
+    let shadow_centre = ball + (ball - light) * (ball.y / (light.y - ball.y));
+    let mut penumbra = 0;
+    for i in 0..=60 {
+        for dir in [Vec3::X, Vec3::Z, Vec3::new(-0.6, 0.0, 0.8)] {
+            let p = Vec3::new(shadow_centre.x, 0.0, shadow_centre.z) + dir * (i as f32 * 0.025);
+            let v = tracer.visibility(Surface::free(p), &s.light, 1024, i) as f64;
+            let (low, high) = (sphere_v(p, light, r, ball, rb), sphere_v(p, light, r, ball, inner));
+            assert!(v > low - 0.01 && v < high + 0.01, "p = {p}: traced {v}, analytic {low}..{high}");
+            penumbra += usize::from(low > 0.05 && high < 0.95);
+        }
+    }
+    assert!(penumbra > 20, "the probes must cross the penumbra ({penumbra})");
+}
+
+/// Width of Parker's penumbra across the half-plane edge: the x range where 0 < V < 1.
+fn parker_penumbra_width(h: f32, big_h: f32, r: f32) -> f32 {
+    let s = half_plane(h, big_h, r);
+    let tracer = TraceScene::new(&s).unwrap();
+    let step = 1e-4;
+    let soft: Vec<f32> = (-3000..6000)
+        .map(|i| i as f32 * step)
+        .filter(|&x| {
+            let v = tracer.parker(Surface::free(Vec3::new(x, 0.0, 0.0)), &s.light);
+            v > 0.001 && v < 0.999
+        })
+        .collect();
+    soft.last().map_or(0.0, |last| last - soft[0] + step)
+}
+
+#[test]
+fn parker_penumbra_vanishes_at_contact_and_grows_linearly_with_height() {
+    let (big_h, r) = (20.0, 1.0);
+    // Parker §3: b = a·D/A, so the penumbra on the ground spans D·h/(H − h).
+    for h in [0.1, 0.2, 0.4] {
+        let width = parker_penumbra_width(h, big_h, r);
+        let expected = 2.0 * r * h / (big_h - h);
+        assert!((width - expected).abs() < 0.05 * expected + 2e-4, "h = {h}: width {width}, expected {expected}");
+    }
+    let contact = parker_penumbra_width(1e-4, big_h, r);
+    assert!(contact <= 2e-4, "a caster touching the ground casts a hard edge, width {contact}");
+}
+
+#[test]
+fn parker_is_never_lighter_than_the_light_allows() {
+    let half = half_plane(1.0, 10.0, 1.0);
+    let ball = sphere_scene(Vec3::new(1.0, 8.0, 0.5), 0.8, Vec3::new(0.0, 1.5, 0.0), 0.5);
+    for s in [&half, &ball] {
+        let tracer = TraceScene::new(s).unwrap();
+        for i in 0..60 {
+            let p = Vec3::new(i as f32 * 0.02 - 0.6, 0.0, (i % 7) as f32 * 0.05 - 0.15);
+            let exact = tracer.visibility(Surface::free(p), &s.light, 1024, i);
+            let parker = tracer.parker(Surface::free(p), &s.light);
+            assert!(parker.is_finite() && (0.0..=1.0).contains(&parker));
+            // The inner object is the occluder itself and the outer one only darkens more.
+            assert!(parker <= exact + 0.01, "p = {p}: parker {parker} lighter than exact {exact}");
+        }
+    }
+}
+
+fn render(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
+    let mut frame = settings(s, size, size);
+    frame.params = softshadow::technique::Params::defaults(softshadow::technique::knobs::find(technique).unwrap());
+    frame.params.apply(sets.iter().copied()).unwrap();
+    e.render_and_capture(s, &frame).unwrap()
+}
+
+fn test_scenes() -> [Scene; 2] {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
+    [Scene::load(format!("{dir}plate.toml")).unwrap(), Scene::load(format!("{dir}sphere.toml")).unwrap()]
+}
+
+/// Fewer texels than the default keep the 1024-sample runs short on lavapipe.
+const MAP: (&str, &str) = ("shadow_map_size", "512");
+
+#[test]
+fn the_reference_agrees_with_raytrace_and_converges() {
+    let mut e = engine();
+    for s in test_scenes() {
+        let truth = render(&mut e, &s, "raytrace", &[("samples", "1024")], 64);
+        let mut last = f64::INFINITY;
+        for n in ["16", "64", "256", "1024"] {
+            let v = render(&mut e, &s, "reference", &[("samples", n), MAP], 64);
+            let m = Metrics::between(&v, &truth).unwrap();
+            assert!(m.pixels > 1000 && m.penumbra_pixels > 50, "{m:?}");
+            assert!(m.excluded * 100 < m.pixels, "surfaces agree almost everywhere: {m:?}");
+            assert!(m.rmse < last, "N = {n}: RMSE {} did not fall below {last}", m.rmse);
+            last = m.rmse;
+        }
+        assert!(last < 0.01, "N = 1024: RMSE {last} against raytrace");
+    }
+    finish(e);
+}
+
+#[test]
+fn a_point_light_makes_every_ground_truth_a_hard_shadow() {
+    let mut s = test_scenes()[0].clone();
+    s.light.radius = 0.0;
+    let mut e = engine();
+    let hard = render(&mut e, &s, "shadow-map", &[MAP], 64);
+    let reference = render(&mut e, &s, "reference", &[("samples", "64"), MAP], 64);
+    // One point: the reference is the shadow map, texel for texel.
+    assert_eq!(reference.visibility, hard.visibility);
+    let traced = render(&mut e, &s, "raytrace", &[], 64);
+    assert!(traced.visibility.iter().all(|&v| v == 0 || v == 65535), "a point light leaves no penumbra");
+    let m = Metrics::between(&reference, &traced).unwrap();
+    assert!(m.rmse < 0.1 && m.p99_abs < 1.0, "{m:?}");
+    finish(e);
+}
