@@ -36,6 +36,7 @@ pub struct LightView {
     pub view_proj: Mat4,
     pub extent: Vec4,
     pub bias: Vec4,
+    pub kernel: Vec4,
 }
 
 /// One point sampled on the area light, with the view its shadow map was rendered through.
@@ -47,10 +48,10 @@ pub struct LightSample {
     pub view: LightView,
     /// xyz the point; w 1 when it has a shadow map, 0 when nothing in view can block it.
     pub position: Vec4,
-    pub pad: [Vec4; 5],
+    pub pad: [Vec4; 4],
 }
 
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
-const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 2 * 16);
+const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);

@@ -29,6 +29,8 @@ struct LightView {
     mat4 view_proj;  // world -> light clip
     vec4 extent;     // tangent-space window: x0, y0, x1, y1 (x/z and y/z of the frustum's sides)
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
+    vec4 kernel;     // PCF: taps, kernel radius, 1 = radius in world units (0 = texels), unused
+                     // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the
@@ -36,7 +38,7 @@ struct LightView {
 struct LightSample {
     LightView view;
     vec4 position;   // xyz; w = 1 with a shadow map, 0 when nothing in view can block it
-    vec4 pad[5];
+    vec4 pad[4];
 };
 
 #endif

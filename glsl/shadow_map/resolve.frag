@@ -1,8 +1,16 @@
 #version 460
-// Hard shadow resolve: one 2x2 bilinear comparison per camera pixel into V.
+// The shadow-map family's resolve, one skeleton specialised per technique: the surface, the
+// self-hiding test and the biased lookup are shared; only the filter differs.
 #include "interface.glsl"
 #include "camera.glsl"
 #include "shadow.glsl"
+#include "filters.glsl"
+
+const int HARD = 0;    // shadow-map: one 2x2 bilinear comparison
+const int DISK = 1;    // pcf: rotated Vogel disk
+const int BICUBIC = 2; // pcf: 4x4 B-spline
+const int PCSS = 3;    // pcss: blocker search, penumbra estimate, PCF
+layout(constant_id = 0) const int FILTER = HARD;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Light { LightView light; };
@@ -24,6 +32,24 @@ void main() {
         return;
     }
     ShadowLookup l = shadow_lookup(light, frame.light.xyz, s.p, s.n);
-    // Outside the fitted frustum nothing can block the light.
-    out_visibility = l.inside ? compare_bilinear(shadow_map, vec2(0.0), light.bias.w, l.uv, l.depth) : 1.0;
+    if (!l.inside) {
+        out_visibility = 1.0; // outside the frustum fitted around every caster
+        return;
+    }
+    float size = light.bias.w;
+    if (FILTER == HARD) {
+        out_visibility = compare_bilinear(shadow_map, vec2(0.0), size, l.uv, l.depth);
+    } else if (FILTER == DISK) {
+        float radius = light.kernel.y;
+        if (light.kernel.z > 0.5) {
+            // World units: divide by the world size of one texel at the receiver.
+            float z = (light.view * vec4(s.p, 1.0)).z;
+            radius *= texels_per_tangent(light).x / z;
+        }
+        out_visibility = pcf_disk(shadow_map, light, l, radius, max(int(light.kernel.x), 1));
+    } else if (FILTER == BICUBIC) {
+        out_visibility = pcf_bicubic(shadow_map, light, l);
+    } else {
+        out_visibility = pcss(shadow_map, light, l, (light.view * vec4(s.p, 1.0)).z);
+    }
 }

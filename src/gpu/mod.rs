@@ -17,7 +17,7 @@ pub use barrier::{Access, copy_to_host, transition};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
 pub use memory::{Buffer, PerFrame};
-pub use pipeline::{Binding, Blend, DepthState, Descriptor, Pipeline, PipelineDesc, VertexInput};
+pub use pipeline::{Binding, Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, VertexInput};
 pub use render::{Attachment, RenderPass, fullscreen};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{PassTime, PassTimer};

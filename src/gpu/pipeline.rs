@@ -73,6 +73,34 @@ pub struct PipelineDesc<'a> {
     pub depth: Option<DepthState>,
     /// Applied to every color target.
     pub blend: Blend,
+    /// Fragment-shader specialization constants: `constant_id = i` takes `constants[i]`.
+    pub constants: &'a [u32],
+}
+
+/// A full-screen pass: its fragment shader reads `bindings` and writes one color target.
+pub struct Fullscreen<'a> {
+    pub name: &'static str,
+    pub fragment: &'a [u32],
+    pub bindings: &'a [Binding],
+    pub format: vk::Format,
+    pub blend: Blend,
+    pub constants: &'a [u32],
+}
+
+impl<'a> Fullscreen<'a> {
+    /// Overwrites the target, no specialization.
+    pub fn new(name: &'static str, fragment: &'a [u32], bindings: &'a [Binding], format: vk::Format) -> Self {
+        Fullscreen { name, fragment, bindings, format, blend: Blend::None, constants: &[] }
+    }
+
+    pub fn blend(self, blend: Blend) -> Self {
+        Fullscreen { blend, ..self }
+    }
+
+    /// Specialization constants, in `constant_id` order.
+    pub fn constants(self, constants: &'a [u32]) -> Self {
+        Fullscreen { constants, ..self }
+    }
 }
 
 /// A pipeline, its layout and its push-descriptor set layout.
@@ -121,39 +149,21 @@ impl Pipeline {
         Ok(pipeline)
     }
 
-    /// A full-screen pass (`glsl/common/fullscreen.vert`) whose fragment shader reads `bindings`
-    /// and overwrites one color target of `format`.
-    pub fn fullscreen(
-        ctx: &Context,
-        name: &'static str,
-        fragment: &[u32],
-        bindings: &[Binding],
-        format: vk::Format,
-    ) -> Result<Self> {
-        Pipeline::fullscreen_blended(ctx, name, fragment, bindings, format, Blend::None)
-    }
-
-    /// [`Pipeline::fullscreen`] whose output is blended into the target.
-    pub fn fullscreen_blended(
-        ctx: &Context,
-        name: &'static str,
-        fragment: &[u32],
-        bindings: &[Binding],
-        format: vk::Format,
-        blend: Blend,
-    ) -> Result<Self> {
-        let bindings: Vec<_> = bindings.iter().map(|b| (*b, vk::ShaderStageFlags::FRAGMENT)).collect();
+    /// A full-screen pass (`glsl/common/fullscreen.vert`) as `desc` describes it.
+    pub fn fullscreen(ctx: &Context, desc: &Fullscreen<'_>) -> Result<Self> {
+        let bindings: Vec<_> = desc.bindings.iter().map(|b| (*b, vk::ShaderStageFlags::FRAGMENT)).collect();
         Pipeline::new(
             ctx,
             &PipelineDesc {
-                name,
+                name: desc.name,
                 vertex: super::shaders::COMMON_FULLSCREEN_VERT,
-                fragment,
+                fragment: desc.fragment,
                 bindings: &bindings,
                 vertex_input: VertexInput::None,
-                color_formats: &[format],
+                color_formats: &[desc.format],
                 depth: None,
-                blend,
+                blend: desc.blend,
+                constants: desc.constants,
             },
         )
     }
@@ -172,12 +182,18 @@ impl Pipeline {
                 return Err(e);
             }
         };
+        let entries: Vec<_> = (0..desc.constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(desc.constants));
         let stages = [
             vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
                 .module(frag)
-                .name(c"main"),
+                .name(c"main")
+                .specialization_info(&specialization),
         ];
         let stride = std::mem::size_of::<crate::scene::Vertex>() as u32;
         let vb = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];

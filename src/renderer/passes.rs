@@ -5,8 +5,8 @@ use ash::vk;
 use super::{CameraTargets, Draw};
 use crate::error::Result;
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, Frame, Pipeline, PipelineDesc, RenderPass,
-    VertexInput, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc,
+    RenderPass, VertexInput, fullscreen, shaders, transition,
 };
 
 /// Facet normal + shadow role, read by the techniques.
@@ -37,6 +37,7 @@ impl Prepass {
                 // Reverse Z: nearer is greater.
                 depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),
                 blend: Blend::None,
+                constants: &[],
             },
         )?;
         Ok(Prepass { pipeline })
@@ -104,7 +105,10 @@ pub struct Composite {
 impl Composite {
     pub fn new(ctx: &Context) -> Result<Self> {
         let b = [Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled, Binding::Sampled];
-        let pipeline = Pipeline::fullscreen(ctx, "composite", shaders::COMPOSITE_COMPOSITE_FRAG, &b, COLOR_FORMAT)?;
+        let pipeline = Pipeline::fullscreen(
+            ctx,
+            &Fullscreen::new("composite", shaders::COMPOSITE_COMPOSITE_FRAG, &b, COLOR_FORMAT),
+        )?;
         Ok(Composite { pipeline })
     }
 

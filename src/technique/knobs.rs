@@ -30,6 +30,8 @@ pub struct TechniqueInfo {
 /// Every technique this build knows.
 pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &crate::technique::shadow_map::INFO,
+    &crate::technique::shadow_map::PCF,
+    &crate::technique::shadow_map::PCSS,
     &crate::technique::reference::INFO,
     &crate::technique::traced::RAYTRACE,
     &crate::technique::traced::PARKER,

@@ -50,9 +50,11 @@ pub trait Technique {
 }
 
 /// Creates the technique `info` names.
-pub fn create(ctx: &Context, info: &TechniqueInfo) -> Result<Box<dyn Technique>> {
+pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Technique>> {
     match info.name {
-        name if name == shadow_map::INFO.name => Ok(Box::new(shadow_map::ShadowMap::new(ctx)?)),
+        name if [shadow_map::INFO.name, shadow_map::PCF.name, shadow_map::PCSS.name].contains(&name) => {
+            Ok(Box::new(shadow_map::ShadowMap::new(ctx, info)?))
+        }
         name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx)?)),
         name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
         name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),

@@ -23,8 +23,8 @@ use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, RenderPass, Target,
-    TargetDesc, ensure, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
+    RenderPass, Target, TargetDesc, ensure, fullscreen, shaders, transition,
 };
 use crate::gpu_types::{LightSample, LightView};
 
@@ -66,13 +66,10 @@ impl Reference {
     pub fn new(ctx: &Context) -> Result<Self> {
         let depth = depth_pipeline(ctx)?;
         let sampled = Binding::Sampled;
-        let accumulate = Pipeline::fullscreen_blended(
+        let bindings = [Binding::Uniform, Binding::Storage, sampled, sampled, sampled];
+        let accumulate = Pipeline::fullscreen(
             ctx,
-            "accumulate",
-            shaders::REFERENCE_ACCUMULATE_FRAG,
-            &[Binding::Uniform, Binding::Storage, sampled, sampled, sampled],
-            SUM_FORMAT,
-            Blend::Add,
+            &Fullscreen::new("accumulate", shaders::REFERENCE_ACCUMULATE_FRAG, &bindings, SUM_FORMAT).blend(Blend::Add),
         );
         let accumulate = match accumulate {
             Ok(p) => p,
@@ -82,7 +79,10 @@ impl Reference {
             }
         };
         let format = crate::renderer::VISIBILITY_FORMAT;
-        match Pipeline::fullscreen(ctx, "resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], format) {
+        match Pipeline::fullscreen(
+            ctx,
+            &Fullscreen::new("resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], format),
+        ) {
             Ok(resolve) => {
                 Ok(Reference { depth, accumulate, resolve, samples: None, atlas: None, atlas_depth: None, sums: None })
             }
@@ -115,9 +115,10 @@ impl Reference {
                     view_proj: f.view_proj,
                     extent: Vec4::from(f.window),
                     bias: Vec4::new(BIAS[0], BIAS[1], BIAS[2], size as f32),
+                    kernel: Vec4::ZERO,
                 });
                 let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
-                LightSample { view, position: q.extend(has_map), pad: [Vec4::ZERO; 5] }
+                LightSample { view, position: q.extend(has_map), pad: [Vec4::ZERO; 4] }
             })
             .collect()
     }

@@ -1,11 +1,13 @@
-//! `shadow-map`: hard shadows from the light's centre (Williams 1978), the baseline every soft
-//! technique is measured against, and pass 1 of the smoothie and PCF/PCSS techniques.
+//! The shadow-map family: `shadow-map` (Williams 1978: hard shadows from the light's centre,
+//! the baseline every soft technique is measured against), `pcf` (Reeves, Salesin & Cook 1987)
+//! and `pcss` (Fernando 2005), the peers a game would otherwise ship. All three share one
+//! [`ShadowMapPass`], also pass 1 of the smoothie, and one resolve skeleton
+//! (`glsl/shadow_map/resolve.frag`) specialised by a constant per filter.
 //!
 //! The map stores linear light-space depth in R32_SFLOAT through a spot frustum fitted every
-//! frame ([`fit_spot_frustum`]). The resolve compares each camera pixel's light depth against
-//! the four nearest texels and filters the results bilinearly. Biases are measured in shadow-map
-//! texels at the receiver (constant + slope-scaled, plus a normal offset), so they hold at any
-//! scene scale and map size.
+//! frame ([`fit_spot_frustum`]). Every lookup is a 2x2 bilinear comparison; biases are measured
+//! in shadow-map texels at the receiver (constant + slope-scaled, plus a normal offset), so they
+//! hold at any scene scale and map size.
 
 use ash::vk;
 use bytemuck::bytes_of;
@@ -16,8 +18,8 @@ use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline,
-    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
 };
 use crate::gpu_types::LightView;
 
@@ -25,33 +27,100 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     offline: false,
     name: "shadow-map",
     summary: "hard shadows from the light's centre: one shadow map, 2x2 bilinear comparison",
+    knobs: &[SHADOW_MAP_SIZE, DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET],
+};
+
+/// Percentage-closer filtering (Reeves, Salesin & Cook 1987) on the same map.
+pub const PCF: TechniqueInfo = TechniqueInfo {
+    offline: false,
+    name: "pcf",
+    summary: "percentage-closer filtering: a rotated Vogel disk of taps, or the 4x4 bicubic of smoothie Fig. 7",
     knobs: &[
         SHADOW_MAP_SIZE,
+        DEPTH_BIAS,
+        SLOPE_BIAS,
+        NORMAL_OFFSET,
+        Knob { name: "taps", default: 16.0, min: 1.0, max: 32.0, integer: true, help: "comparisons on the disk" },
         Knob {
-            name: "depth_bias",
-            default: 1.0,
+            name: "radius",
+            default: 2.0,
             min: 0.0,
-            max: 64.0,
+            max: 256.0,
             integer: false,
-            help: "constant depth bias, in shadow-map texels",
+            help: "disk radius, in texels (or world units with radius_world = 1)",
         },
         Knob {
-            name: "slope_bias",
-            default: 1.0,
+            name: "radius_world",
+            default: 0.0,
             min: 0.0,
-            max: 64.0,
-            integer: false,
-            help: "depth bias per unit tan(angle to the light), in texels",
+            max: 1.0,
+            integer: true,
+            help: "1: radius in world units at the receiver; 0: in shadow-map texels",
         },
         Knob {
-            name: "normal_offset",
-            default: 1.5,
+            name: "bicubic",
+            default: 0.0,
             min: 0.0,
-            max: 64.0,
-            integer: false,
-            help: "lookup offset along the normal at grazing angles, in texels",
+            max: 1.0,
+            integer: true,
+            help: "1: a 4x4 bicubic B-spline footprint instead of the disk",
         },
     ],
+};
+
+/// Percentage-closer soft shadows (Fernando 2005) on the same map.
+pub const PCSS: TechniqueInfo = TechniqueInfo {
+    offline: false,
+    name: "pcss",
+    summary: "percentage-closer soft shadows: blocker search, penumbra from similar triangles, PCF",
+    knobs: &[
+        SHADOW_MAP_SIZE,
+        DEPTH_BIAS,
+        SLOPE_BIAS,
+        NORMAL_OFFSET,
+        Knob {
+            name: "blocker_samples",
+            default: 16.0,
+            min: 1.0,
+            max: 64.0,
+            integer: true,
+            help: "taps of the blocker search",
+        },
+        Knob { name: "filter_samples", default: 16.0, min: 1.0, max: 64.0, integer: true, help: "taps of the PCF" },
+        Knob {
+            name: "light_size_scale",
+            default: 1.0,
+            min: 0.0,
+            max: 16.0,
+            integer: false,
+            help: "light size used, as a multiple of the scene light's radius",
+        },
+    ],
+};
+
+const DEPTH_BIAS: Knob = Knob {
+    name: "depth_bias",
+    default: 1.0,
+    min: 0.0,
+    max: 64.0,
+    integer: false,
+    help: "constant depth bias, in shadow-map texels",
+};
+const SLOPE_BIAS: Knob = Knob {
+    name: "slope_bias",
+    default: 1.0,
+    min: 0.0,
+    max: 64.0,
+    integer: false,
+    help: "depth bias per unit tan(angle to the light), in texels",
+};
+const NORMAL_OFFSET: Knob = Knob {
+    name: "normal_offset",
+    default: 1.5,
+    min: 0.0,
+    max: 64.0,
+    integer: false,
+    help: "lookup offset along the normal at grazing angles, in texels",
 };
 
 /// Shared by every technique that renders a shadow map.
@@ -83,6 +152,7 @@ pub(crate) fn depth_pipeline(ctx: &Context) -> Result<Pipeline> {
             color_formats: &[vk::Format::R32_SFLOAT],
             depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
             blend: Blend::None,
+            constants: &[],
         },
     )
 }
@@ -129,13 +199,15 @@ impl ShadowMapPass {
         fit_spot_frustum(light.position, aim, &casters, frame.receivers_in_view)
     }
 
-    /// Records the map; afterwards it is ready to be sampled by fragment shaders.
+    /// Records the map; afterwards it is ready to be sampled by fragment shaders. `bias` and
+    /// `filter` are passed on to the resolve in the `LightView` (glsl/common/interface.glsl).
     pub fn record(
         &mut self,
         frame: &mut FrameInputs<'_>,
         frustum: &LightFrustum,
         size: u32,
         bias: [f32; 3],
+        filter: Vec4,
     ) -> Result<()> {
         let ctx = frame.ctx;
         ensure(ctx, &mut self.map, TargetDesc::color("shadow map", vk::Format::R32_SFLOAT, size, size))?;
@@ -145,6 +217,7 @@ impl ShadowMapPass {
             view_proj: frustum.view_proj,
             extent: Vec4::from(frustum.window),
             bias: Vec4::new(bias[0], bias[1], bias[2], size as f32),
+            kernel: filter,
         };
         self.light.write(frame.slot, bytes_of(&view));
         let (map, depth) = (self.map.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));
@@ -182,24 +255,56 @@ impl ShadowMapPass {
     }
 }
 
-/// The `shadow-map` technique: [`ShadowMapPass`], then a hard resolve into V.
+/// The resolve variants: specialization constant 0 of `glsl/shadow_map/resolve.frag`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Filter {
+    Hard = 0,
+    Disk = 1,
+    Bicubic = 2,
+    Pcss = 3,
+}
+
+/// `shadow-map`, `pcf` and `pcss`: one [`ShadowMapPass`], then one resolve skeleton
+/// specialised by the filter.
 pub struct ShadowMap {
+    technique: &'static TechniqueInfo,
     pass: ShadowMapPass,
-    resolve: Pipeline,
+    /// Resolve pipelines made so far, by filter (a `pcf` knob can switch filters).
+    resolves: Vec<(Filter, Pipeline)>,
 }
 
 impl ShadowMap {
-    pub fn new(ctx: &Context) -> Result<Self> {
-        let pass = ShadowMapPass::new(ctx)?;
+    pub fn new(ctx: &Context, technique: &'static TechniqueInfo) -> Result<Self> {
+        Ok(ShadowMap { technique, pass: ShadowMapPass::new(ctx)?, resolves: Vec::new() })
+    }
+
+    /// Index in `resolves` of the pipeline for `filter`, made on first use.
+    fn resolve(&mut self, ctx: &Context, filter: Filter) -> Result<usize> {
+        if let Some(i) = self.resolves.iter().position(|(f, _)| *f == filter) {
+            return Ok(i);
+        }
         let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
         let format = crate::renderer::VISIBILITY_FORMAT;
-        let resolve = Pipeline::fullscreen(ctx, "resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, format);
-        match resolve {
-            Ok(resolve) => Ok(ShadowMap { pass, resolve }),
-            Err(e) => {
-                pass.destroy(ctx);
-                Err(e)
+        let constants = [filter as u32];
+        let desc = Fullscreen::new("resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, format).constants(&constants);
+        self.resolves.push((filter, Pipeline::fullscreen(ctx, &desc)?));
+        Ok(self.resolves.len() - 1)
+    }
+
+    /// The filter and its `LightView.filter` parameters for this frame's knobs.
+    fn filter(&self, params: &Params, frame: &FrameInputs<'_>, frustum: &LightFrustum) -> (Filter, Vec4) {
+        match self.technique.name {
+            name if name == PCF.name && params.get("bicubic") == 1.0 => (Filter::Bicubic, Vec4::ZERO),
+            name if name == PCF.name => {
+                let [taps, radius, world] = ["taps", "radius", "radius_world"].map(|k| params.get(k) as f32);
+                (Filter::Disk, Vec4::new(taps, radius, world, 0.0))
             }
+            name if name == PCSS.name => {
+                let radius = frame.scene.light.radius * params.get("light_size_scale") as f32;
+                let [taps, blockers] = ["filter_samples", "blocker_samples"].map(|k| params.get(k) as f32);
+                (Filter::Pcss, Vec4::new(taps, radius, frustum.near, blockers))
+            }
+            _ => (Filter::Hard, Vec4::ZERO),
         }
     }
 }
@@ -211,16 +316,19 @@ impl Technique for ShadowMap {
         };
         let size = params.get("shadow_map_size") as u32;
         let bias = ["depth_bias", "slope_bias", "normal_offset"].map(|k| params.get(k) as f32);
-        self.pass.record(frame, &frustum, size, bias)?;
+        let (filter, filter_params) = self.filter(params, frame, &frustum);
+        self.pass.record(frame, &frustum, size, bias, filter_params)?;
 
         let (ctx, cmd) = (frame.ctx, frame.cmd);
+        let index = self.resolve(ctx, filter)?;
+        let resolve = &self.resolves[index].1;
         let (map, light) = self.pass.inputs(frame.slot);
         frame.timer.begin(ctx, cmd, "resolve");
         transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
         fullscreen(
             ctx,
             cmd,
-            &self.resolve,
+            resolve,
             visibility,
             &[
                 Descriptor::Buffer(frame.globals),
@@ -236,6 +344,6 @@ impl Technique for ShadowMap {
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         self.pass.destroy(ctx);
-        self.resolve.destroy(ctx);
+        self.resolves.into_iter().for_each(|(_, p)| p.destroy(ctx));
     }
 }
