@@ -4,11 +4,10 @@
 
 mod common;
 
-use common::{engine, finish, scene, settings};
+use common::{engine, finish, render_with, scene};
+use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, knobs};
-use softshadow::{Capture, Engine};
 
 /// A thin wall standing on the ground at x = 0 under a light at +x, seen from straight above
 /// (image x = world x, image rows = world z, 3 m across): its shadow runs to −x, and the penumbra
@@ -37,13 +36,6 @@ fn column(x: f32) -> u32 {
     ((x + 2.5) / 3.0 * SIZE as f32) as u32
 }
 
-fn render(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
-    let mut frame = settings(s, size, size);
-    frame.params = Params::defaults(knobs::find(technique).unwrap());
-    frame.params.apply(sets.iter().copied()).unwrap();
-    e.render_and_capture(s, &frame).unwrap()
-}
-
 /// Penumbra pixels (0.02 < V < 0.98) down column `x` across the wall shadow's +z side edge.
 fn edge_width(c: &Capture, x: u32) -> usize {
     (SIZE / 2..SIZE).filter(|&y| (0.02..0.98).contains(&c.visibility_at(x, y))).count()
@@ -53,7 +45,7 @@ fn edge_width(c: &Capture, x: u32) -> usize {
 fn pcss_hardens_at_contact_and_widens_with_distance_while_pcf_keeps_its_width() {
     let s = scene(WALL);
     let mut e = engine();
-    let pcss = render(&mut e, &s, "pcss", &[], SIZE);
+    let pcss = render_with(&mut e, &s, "pcss", &[], SIZE);
     let (near, far) = (edge_width(&pcss, column(-0.15)), edge_width(&pcss, column(-1.8)));
     // Physically the penumbra is about 0.03 m (1.3 px) near the foot and 0.3 m (13 px) far out.
     assert!(near <= 3, "PCSS near the contact: {near} px of penumbra");
@@ -61,7 +53,7 @@ fn pcss_hardens_at_contact_and_widens_with_distance_while_pcf_keeps_its_width() 
     let mid = edge_width(&pcss, column(-0.9));
     assert!(near <= mid && mid <= far, "PCSS widens steadily: {near} {mid} {far}");
 
-    let pcf = render(&mut e, &s, "pcf", &[("radius", "0.08"), ("radius_world", "1")], SIZE);
+    let pcf = render_with(&mut e, &s, "pcf", &[("radius", "0.08"), ("radius_world", "1")], SIZE);
     let widths: Vec<usize> = [-0.15, -0.9, -1.8].iter().map(|&x| edge_width(&pcf, column(x))).collect();
     // A 0.08 m disk blurs a hard edge over 0.16 m, about 7 px, wherever the edge is.
     assert!(widths.iter().all(|&w| (4..=10).contains(&w)), "PCF widths {widths:?}");
@@ -85,7 +77,7 @@ fn extreme_settings_stay_sane() {
         ("pcss", &[("light_size_scale", "0")]),
     ];
     for (technique, sets) in settings {
-        let c = render(&mut e, &s, technique, sets, 64);
+        let c = render_with(&mut e, &s, technique, sets, 64);
         // The blocker search finds everything in the umbra and nothing on open ground: neither
         // may turn into NaN (which a UNORM target would store as 0).
         let (u, l) = (c.visibility_at(umbra.0 / 2, umbra.1 / 2), c.visibility_at(lit.0 / 2, lit.1 / 2));
@@ -101,8 +93,8 @@ fn a_point_light_makes_pcss_the_hard_shadow() {
     let mut s = scene(WALL);
     s.light.radius = 0.0;
     let mut e = engine();
-    let hard = render(&mut e, &s, "shadow-map", &[], 64);
-    let pcss = render(&mut e, &s, "pcss", &[], 64);
+    let hard = render_with(&mut e, &s, "shadow-map", &[], 64);
+    let pcss = render_with(&mut e, &s, "pcss", &[], 64);
     let m = Metrics::between(&pcss, &hard).unwrap();
     assert!(m.p99_abs < 0.5 && m.rmse < 0.05, "{m:?}");
     finish(e);
@@ -130,10 +122,10 @@ fn pcf_and_pcss_stay_within_their_bounds_of_the_reference() {
     ];
     let mut e = engine();
     for (name, s) in &scenes {
-        let truth = render(&mut e, s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
+        let truth = render_with(&mut e, s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
         let mut rmse = Vec::new();
         for (_, technique, bound) in BOUNDS.iter().filter(|(n, ..)| n == name) {
-            let m = Metrics::between(&render(&mut e, s, technique, &[], 64), &truth).unwrap();
+            let m = Metrics::between(&render_with(&mut e, s, technique, &[], 64), &truth).unwrap();
             assert!(m.rmse < *bound, "{name} {technique}: RMSE {} over {bound}", m.rmse);
             rmse.push(m.rmse);
         }

@@ -6,34 +6,28 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{engine, finish, scene, settings};
+use common::{engine, finish, render_with, scene};
 use glam::Vec3;
 use softshadow::measure::Metrics;
 use softshadow::reference::{Surface, TraceScene};
 use softshadow::scene::Scene;
-use softshadow::{Capture, Engine};
+
+/// The ground under a light at `light` of radius `r` and one object (its TOML keys).
+fn over_ground(light: Vec3, r: f32, object: &str) -> Scene {
+    scene(&format!(
+        "[camera]\nposition = [0.0, 6.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y_deg = 40.0\n\
+         [light]\nposition = [{}, {}, {}]\nradius = {r}\n\
+         [ground]\nheight = 0.0\nhalf_size = 30.0\n\
+         [[object]]\n{object}",
+        light.x, light.y, light.z
+    ))
+}
 
 /// A plate covering x < 0 (40 m square, a half-plane for any light footprint near x = 0) at
 /// height `h` over the ground, under a light of radius `r` at height `big_h` above x = 0.
 fn half_plane(h: f32, big_h: f32, r: f32) -> Scene {
-    scene(&format!(
-        r#"
-[camera]
-position = [0.0, 6.0, 6.0]
-target = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[light]
-position = [0.0, {big_h}, 0.0]
-radius = {r}
-[ground]
-height = 0.0
-half_size = 30.0
-[[object]]
-shape = "plate"
-size = [40.0, 0.0, 40.0]
-position = [-20.0, {h}, 0.0]
-"#
-    ))
+    let plate = format!("shape = \"plate\"\nsize = [40.0, 0.0, 40.0]\nposition = [-20.0, {h}, 0.0]\n");
+    over_ground(Vec3::new(0.0, big_h, 0.0), r, &plate)
 }
 
 /// V under a half-plane edge (the light seen as a disk, its footprint cut by the edge): the
@@ -69,24 +63,8 @@ fn sphere_v(p: Vec3, light: Vec3, r: f32, ball: Vec3, rb: f32) -> f64 {
 }
 
 fn sphere_scene(light: Vec3, r: f32, ball: Vec3, rb: f32) -> Scene {
-    scene(&format!(
-        r#"
-[camera]
-position = [0.0, 5.0, 7.0]
-target = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[light]
-position = [{}, {}, {}]
-radius = {r}
-[ground]
-height = 0.0
-[[object]]
-shape = "sphere"
-radius = {rb}
-position = [{}, {}, {}]
-"#,
-        light.x, light.y, light.z, ball.x, ball.y, ball.z
-    ))
+    let sphere = format!("shape = \"sphere\"\nradius = {rb}\nposition = [{}, {}, {}]\n", ball.x, ball.y, ball.z);
+    over_ground(light, r, &sphere)
 }
 
 #[test]
@@ -172,13 +150,6 @@ fn parker_is_never_lighter_than_the_light_allows() {
     }
 }
 
-fn render(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
-    let mut frame = settings(s, size, size);
-    frame.params = softshadow::technique::Params::defaults(softshadow::technique::knobs::find(technique).unwrap());
-    frame.params.apply(sets.iter().copied()).unwrap();
-    e.render_and_capture(s, &frame).unwrap()
-}
-
 fn test_scenes() -> [Scene; 2] {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
     [Scene::load(format!("{dir}plate.toml")).unwrap(), Scene::load(format!("{dir}sphere.toml")).unwrap()]
@@ -191,10 +162,10 @@ const MAP: (&str, &str) = ("shadow_map_size", "512");
 fn the_reference_agrees_with_raytrace_and_converges() {
     let mut e = engine();
     for s in test_scenes() {
-        let truth = render(&mut e, &s, "raytrace", &[("samples", "1024")], 64);
+        let truth = render_with(&mut e, &s, "raytrace", &[("samples", "1024")], 64);
         let mut last = f64::INFINITY;
         for n in ["16", "64", "256", "1024"] {
-            let v = render(&mut e, &s, "reference", &[("samples", n), MAP], 64);
+            let v = render_with(&mut e, &s, "reference", &[("samples", n), MAP], 64);
             let m = Metrics::between(&v, &truth).unwrap();
             assert!(m.pixels > 1000 && m.penumbra_pixels > 50, "{m:?}");
             assert!(m.excluded * 100 < m.pixels, "surfaces agree almost everywhere: {m:?}");
@@ -211,11 +182,11 @@ fn a_point_light_makes_every_ground_truth_a_hard_shadow() {
     let mut s = test_scenes()[0].clone();
     s.light.radius = 0.0;
     let mut e = engine();
-    let hard = render(&mut e, &s, "shadow-map", &[MAP], 64);
-    let reference = render(&mut e, &s, "reference", &[("samples", "64"), MAP], 64);
+    let hard = render_with(&mut e, &s, "shadow-map", &[MAP], 64);
+    let reference = render_with(&mut e, &s, "reference", &[("samples", "64"), MAP], 64);
     // One point: the reference is the shadow map, texel for texel.
     assert_eq!(reference.visibility, hard.visibility);
-    let traced = render(&mut e, &s, "raytrace", &[], 64);
+    let traced = render_with(&mut e, &s, "raytrace", &[], 64);
     assert!(traced.visibility.iter().all(|&v| v == 0 || v == 65535), "a point light leaves no penumbra");
     let m = Metrics::between(&reference, &traced).unwrap();
     assert!(m.rmse < 0.1 && m.p99_abs < 1.0, "{m:?}");

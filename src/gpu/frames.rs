@@ -100,8 +100,22 @@ impl FrameRing {
 
     /// Waits for slot `slot`'s frame to finish and returns its pass times (once).
     pub fn wait(&mut self, ctx: &Context, slot: usize) -> Result<Option<Vec<PassTime>>> {
+        self.wait_ticking(ctx, slot, &mut || {})
+    }
+
+    /// [`FrameRing::wait`], calling `tick` every tenth of a second while the frame runs.
+    pub fn wait_ticking(
+        &mut self,
+        ctx: &Context,
+        slot: usize,
+        tick: &mut dyn FnMut(),
+    ) -> Result<Option<Vec<PassTime>>> {
         let s = &mut self.slots[slot];
-        unsafe { ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        const TICK_NS: u64 = 100_000_000;
+        while unsafe { ctx.device.wait_for_fences(&[s.fence], true, TICK_NS) } == Err(vk::Result::TIMEOUT) {
+            tick();
+        }
+        unsafe { ctx.device.wait_for_fences(&[s.fence], true, 0) }.vk("vkWaitForFences")?;
         s.timer.collect(ctx)
     }
 

@@ -20,5 +20,5 @@ pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Binding, Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, VertexInput};
 pub use render::{Attachment, RenderPass, fullscreen};
 pub use target::{Target, TargetDesc, ensure};
-pub use timestamps::{PassTime, PassTimer};
+pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{copy_to_target, upload};

@@ -122,6 +122,24 @@ impl Target {
         self.desc.extent
     }
 
+    /// A copy between all of this image and tightly packed texels at `buffer_offset`.
+    pub fn whole_copy(&self, buffer_offset: u64) -> vk::BufferImageCopy {
+        let extent = self.extent();
+        vk::BufferImageCopy {
+            buffer_offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: vk::ImageSubresourceLayers {
+                aspect_mask: self.desc.aspect(),
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            },
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
+        }
+    }
+
     pub fn destroy(mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_image_view(self.view, None);

@@ -98,3 +98,57 @@ impl PassTimer {
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
     }
 }
+
+/// Milestones of one long frame (a batch done, a batch done, ...): timestamps written as the
+/// GPU gets through the work and polled without waiting, so the host can tell how far along a
+/// frame of many seconds is.
+pub struct Milestones {
+    pool: vk::QueryPool,
+    capacity: u32,
+    written: u32,
+}
+
+impl Milestones {
+    pub fn new(ctx: &Context, capacity: u32) -> Result<Self> {
+        let ci = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(capacity);
+        let pool = unsafe { ctx.device.create_query_pool(&ci, None) }.vk("vkCreateQueryPool")?;
+        ctx.name(pool, "milestones");
+        Ok(Milestones { pool, capacity, written: 0 })
+    }
+
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Starts a frame's recording.
+    pub fn reset(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        unsafe { ctx.device.cmd_reset_query_pool(cmd, self.pool, 0, self.capacity) };
+        self.written = 0;
+    }
+
+    /// Records a milestone, reached when all earlier work is done. Beyond capacity: ignored.
+    pub fn mark(&mut self, ctx: &Context, cmd: vk::CommandBuffer) {
+        if self.written < self.capacity {
+            unsafe {
+                ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, self.pool, self.written)
+            };
+            self.written += 1;
+        }
+    }
+
+    /// Milestones reached so far, and how many were recorded.
+    pub fn reached(&self, ctx: &Context) -> (u32, u32) {
+        if self.written == 0 {
+            return (0, 0);
+        }
+        let mut results = vec![[0u64; 2]; self.written as usize];
+        let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY;
+        // NOT_READY just means some are still pending: their availability words say which.
+        let _ = unsafe { ctx.device.get_query_pool_results(self.pool, 0, &mut results, flags) };
+        (results.iter().take_while(|r| r[1] != 0).count() as u32, self.written)
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}

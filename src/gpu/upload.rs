@@ -81,20 +81,7 @@ fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Res
 /// into all of `target`, whose old contents are discarded.
 pub fn copy_to_target(ctx: &Context, cmd: vk::CommandBuffer, src: vk::DescriptorBufferInfo, target: &mut Target) {
     transition(ctx, cmd, &mut [(target, Access::COPY_WRITE, true)]);
-    let extent = target.extent();
-    let region = vk::BufferImageCopy {
-        buffer_offset: src.offset,
-        buffer_row_length: 0,
-        buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers {
-            aspect_mask: target.desc.aspect(),
-            mip_level: 0,
-            base_array_layer: 0,
-            layer_count: 1,
-        },
-        image_offset: vk::Offset3D::default(),
-        image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
-    };
+    let region = target.whole_copy(src.offset);
     unsafe {
         ctx.device.cmd_copy_buffer_to_image(
             cmd,

@@ -23,19 +23,7 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
     let pixels = extent.width as u64 * extent.height as u64;
     let mut offset = 0;
     for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(PIXEL_BYTES) {
-        let region = vk::BufferImageCopy {
-            buffer_offset: offset,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: target.desc.aspect(),
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
-        };
+        let region = target.whole_copy(offset);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
                 cmd,

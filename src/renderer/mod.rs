@@ -336,7 +336,23 @@ impl Engine {
             return Ok(None);
         }
         let frames = self.frames.as_mut().expect("engine is built");
-        let done = frames.wait(&self.ctx, slot)?;
+        let technique = &self.technique.as_ref().expect("ensured").1;
+        let (mut bar, mut ticks) = (None, 0);
+        // A frame of many seconds (the reference at high sample counts) shows a progress bar on
+        // a terminal after half a second; indicatif draws nothing when stderr is not one.
+        let done = frames.wait_ticking(&self.ctx, slot, &mut || {
+            ticks += 1;
+            if ticks < 5 {
+                return;
+            }
+            if let Some((done, total)) = technique.progress(&self.ctx, slot) {
+                let bar = bar.get_or_insert_with(|| indicatif::ProgressBar::new(total as u64).with_message("batches"));
+                bar.set_position(done as u64);
+            }
+        })?;
+        if let Some(bar) = bar {
+            bar.finish_and_clear();
+        }
         self.push_timings(done);
         let mut capture = Capture::read(self.readback.as_ref().expect("ensured"), w, h, &camera);
         if let Some((_, t)) = &self.technique

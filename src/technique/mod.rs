@@ -46,6 +46,11 @@ pub trait Technique {
     fn traced_surfaces(&self) -> Option<&crate::renderer::Surfaces> {
         None
     }
+    /// For GPU work of many seconds: (steps done, steps) of the frame in `slot`, polled while
+    /// the host waits for it.
+    fn progress(&self, _ctx: &Context, _slot: usize) -> Option<(u32, u32)> {
+        None
+    }
     fn destroy(self: Box<Self>, ctx: &Context);
 }
 

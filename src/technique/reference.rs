@@ -23,8 +23,8 @@ use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
-    RenderPass, Target, TargetDesc, ensure, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Milestones, PerFrame,
+    Pipeline, RenderPass, Target, TargetDesc, ensure, fullscreen, shaders, transition,
 };
 use crate::gpu_types::{LightSample, LightView};
 
@@ -60,6 +60,8 @@ pub struct Reference {
     atlas: Option<Target>,
     atlas_depth: Option<Target>,
     sums: Option<Target>,
+    /// One milestone per batch, per frame slot: progress of long frames.
+    milestones: Vec<Milestones>,
 }
 
 impl Reference {
@@ -84,7 +86,17 @@ impl Reference {
             &Fullscreen::new("resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], format),
         ) {
             Ok(resolve) => {
-                Ok(Reference { depth, accumulate, resolve, samples: None, atlas: None, atlas_depth: None, sums: None })
+                let reference = Reference {
+                    depth,
+                    accumulate,
+                    resolve,
+                    samples: None,
+                    atlas: None,
+                    atlas_depth: None,
+                    sums: None,
+                    milestones: Vec::new(),
+                };
+                Ok(reference)
             }
             Err(e) => {
                 depth.destroy(ctx);
@@ -163,8 +175,19 @@ impl Technique for Reference {
         );
 
         let cmd = frame.cmd;
-        frame.timer.begin(ctx, cmd, "accumulate");
         let per_batch = (tiles * tiles) as usize;
+        let batches = samples.len().div_ceil(per_batch) as u32;
+        if self.milestones.first().is_none_or(|m| m.capacity() < batches) {
+            // Grows only; the old pools may still be written by the frame in flight.
+            ctx.wait_idle()?;
+            std::mem::take(&mut self.milestones).into_iter().for_each(|m| m.destroy(ctx));
+            for _ in 0..FRAMES_IN_FLIGHT {
+                self.milestones.push(Milestones::new(ctx, batches)?);
+            }
+        }
+        let milestones = &mut self.milestones[frame.slot];
+        milestones.reset(ctx, cmd);
+        frame.timer.begin(ctx, cmd, "accumulate");
         for (b, batch) in samples.chunks(per_batch).enumerate() {
             let first = (b * per_batch) as u64 * SAMPLE_BYTES;
             // The previous batch's maps have been summed: discard them.
@@ -204,6 +227,7 @@ impl Technique for Reference {
             );
             unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
             pass.end(ctx, cmd);
+            milestones.mark(ctx, cmd);
         }
         transition(ctx, cmd, &mut [(sums, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
@@ -215,8 +239,13 @@ impl Technique for Reference {
         Ok(())
     }
 
+    fn progress(&self, ctx: &Context, slot: usize) -> Option<(u32, u32)> {
+        self.milestones.get(slot).map(|m| m.reached(ctx))
+    }
+
     fn destroy(self: Box<Self>, ctx: &Context) {
         let this = *self;
+        this.milestones.into_iter().for_each(|m| m.destroy(ctx));
         for p in [this.depth, this.accumulate, this.resolve] {
             p.destroy(ctx);
         }

@@ -4,7 +4,8 @@
 
 use softshadow::gpu::ContextOptions;
 use softshadow::scene::Scene;
-use softshadow::{Engine, FrameSettings};
+use softshadow::technique::{Params, knobs};
+use softshadow::{Capture, Engine, FrameSettings};
 
 pub fn engine() -> Engine {
     Engine::headless(&ContextOptions { validation: true, device: None })
@@ -19,6 +20,14 @@ pub fn finish(engine: Engine) {
 
 pub fn scene(text: &str) -> Scene {
     Scene::from_toml(text, "tests/inline.toml").expect("valid test scene")
+}
+
+/// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
+pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
+    let mut frame = settings(s, size, size);
+    frame.params = Params::defaults(knobs::find(technique).expect("a known technique"));
+    frame.params.apply(sets.iter().copied()).expect("valid knobs");
+    e.render_and_capture(s, &frame).expect("a rendered frame")
 }
 
 pub fn settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
