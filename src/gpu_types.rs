@@ -51,7 +51,20 @@ pub struct LightSample {
     pub pad: [Vec4; 4],
 }
 
+/// The plateau texture's frame: the receiver plane and the window of it the texture covers.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PlateauView {
+    pub umbra: Mat4,
+    pub plane_origin: Vec4,
+    pub plane_normal: Vec4,
+    pub plane_u: Vec4,
+    pub plane_v: Vec4,
+    pub window: Vec4,
+}
+
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
+const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);

@@ -41,4 +41,14 @@ struct LightSample {
     vec4 pad[4];
 };
 
+// The plateau texture's frame (Haines): the receiver plane, in-plane axes, the window.
+struct PlateauView {
+    mat4 umbra;         // world -> plateau clip: window * plane coordinates * Blinn, z = 0 (hither)
+    vec4 plane_origin;  // xyz; w = how far off the plane a surface may be and still be on it
+    vec4 plane_normal;  // xyz; w = off-plane receivers: 0 unshadowed, 1 projected light map
+    vec4 plane_u;       // xyz; w = falloff row: 0 linear, 1 sine, 2 smoothstep
+    vec4 plane_v;       // xyz
+    vec4 window;        // u0, v0, u1, v1: the part of the plane the texture covers
+};
+
 #endif

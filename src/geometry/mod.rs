@@ -5,6 +5,7 @@ mod bounds;
 mod clip;
 mod light_frustum;
 mod light_samples;
+pub mod plateau;
 mod projection;
 
 pub use bounds::Aabb;

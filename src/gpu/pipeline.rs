@@ -41,6 +41,8 @@ pub enum VertexInput {
     Position,
     /// `Vertex`: position (location 0) and normal (location 1).
     PositionNormal,
+    /// Three packed floats (location 0), 12 bytes apart: generated geometry.
+    Packed3,
 }
 
 /// Depth test and write of a pipeline.
@@ -211,7 +213,12 @@ impl Pipeline {
                 offset: 12,
             },
         ];
+        let packed =
+            [vk::VertexInputBindingDescription { binding: 0, stride: 12, input_rate: vk::VertexInputRate::VERTEX }];
         let vertex_input = match desc.vertex_input {
+            VertexInput::Packed3 => vk::PipelineVertexInputStateCreateInfo::default()
+                .vertex_binding_descriptions(&packed)
+                .vertex_attribute_descriptions(&attrs[..1]),
             VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
             VertexInput::Position => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&vb)

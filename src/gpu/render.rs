@@ -107,3 +107,21 @@ pub fn fullscreen(
     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
     pass.end(ctx, cmd);
 }
+
+/// Draws `count` vertices of the tightly packed vertex buffer range `vertices` from `first`
+/// (generated geometry), with the bound pipeline.
+pub fn draw_vertices(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    vertices: vk::DescriptorBufferInfo,
+    first: u32,
+    count: u32,
+) {
+    if count == 0 {
+        return;
+    }
+    unsafe {
+        ctx.device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.buffer], &[vertices.offset]);
+        ctx.device.cmd_draw(cmd, count, 1, first, 0);
+    }
+}

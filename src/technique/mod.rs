@@ -2,6 +2,7 @@
 //! A technique builds only what the scene in front of it needs.
 
 pub mod knobs;
+pub mod plateau;
 pub mod reference;
 pub mod shadow_map;
 pub mod traced;
@@ -61,6 +62,7 @@ pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Tec
             Ok(Box::new(shadow_map::ShadowMap::new(ctx, info)?))
         }
         name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx)?)),
+        name if name == plateau::INFO.name => Ok(Box::new(plateau::Plateau::new(ctx)?)),
         name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
         name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),
         other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),

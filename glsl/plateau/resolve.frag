@@ -1,0 +1,68 @@
+#version 460
+// Plateau resolve: receivers on the plane read the plateau texture where they stand; V is the
+// falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
+#include "interface.glsl"
+#include "camera.glsl"
+
+layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
+layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
+layout(set = 0, binding = 2) uniform sampler2D camera_depth;
+layout(set = 0, binding = 3) uniform sampler2D camera_normal;
+layout(set = 0, binding = 4) uniform sampler2D plateau_texture;
+layout(set = 0, binding = 5) uniform sampler2D falloff;
+
+layout(location = 0) in vec2 in_uv;
+layout(location = 0) out float out_visibility;
+
+// Bilinear t from the plateau texture (the sampler is nearest): the gradient stays smooth.
+float plateau_t(vec2 tc) {
+    vec2 size = vec2(textureSize(plateau_texture, 0));
+    vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
+    ivec2 i = ivec2(floor(pos));
+    vec2 f = fract(pos);
+    float a = mix(texelFetch(plateau_texture, i, 0).r, texelFetch(plateau_texture, i + ivec2(1, 0), 0).r, f.x);
+    float b = mix(texelFetch(plateau_texture, i + ivec2(0, 1), 0).r, texelFetch(plateau_texture, i + ivec2(1, 1), 0).r, f.x);
+    return mix(a, b, f.y);
+}
+
+// The falloff row's value at t, interpolated between its 256 entries.
+float falloff_at(float t) {
+    float x = clamp(t, 0.0, 1.0) * 255.0;
+    int row = int(plateau.plane_u.w);
+    float lo = texelFetch(falloff, ivec2(int(floor(x)), row), 0).r;
+    float hi = texelFetch(falloff, ivec2(min(int(floor(x)) + 1, 255), row), 0).r;
+    return mix(lo, hi, fract(x));
+}
+
+void main() {
+    Surface s = read_surface(frame, camera_depth, camera_normal, in_uv);
+    if (!s.receives) {
+        out_visibility = 1.0;
+        return;
+    }
+    if (hides_itself(s, frame.light.xyz)) {
+        out_visibility = 0.0;
+        return;
+    }
+    vec3 n = plateau.plane_normal.xyz;
+    vec3 o = plateau.plane_origin.xyz;
+    float h = dot(s.p - o, n);
+    vec3 q = s.p;
+    if (abs(h) > plateau.plane_origin.w || dot(s.n, n) < 0.99) {
+        // Off the plane: unshadowed, or (mode 1, receivers that cast nothing) the paper's
+        // projected light map: the texture where the ray from the light through p meets the plane.
+        float hl = dot(frame.light.xyz - o, n);
+        if (plateau.plane_normal.w < 0.5 || s.casts || h >= hl) {
+            out_visibility = 1.0;
+            return;
+        }
+        q = frame.light.xyz + (s.p - frame.light.xyz) * (hl / (hl - h));
+    }
+    vec2 uv = vec2(dot(q - o, plateau.plane_u.xyz), dot(q - o, plateau.plane_v.xyz));
+    vec2 tc = (uv - plateau.window.xy) / (plateau.window.zw - plateau.window.xy);
+    if (any(lessThan(tc, vec2(0.0))) || any(greaterThan(tc, vec2(1.0)))) {
+        out_visibility = 1.0; // beyond the shadow's footprint
+        return;
+    }
+    out_visibility = falloff_at(plateau_t(tc));
+}

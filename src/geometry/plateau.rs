@@ -1,0 +1,378 @@
+//! Haines' plateaus ("Soft Planar Shadows Using Plateaus", 2001) as pure geometry: the plateau
+//! object whose plan view is the soft shadow texture. Its top is the hard drop shadow (the
+//! umbra, drawn by the GPU with [`ReceiverPlane::shadow_matrix`]); its sides are a cone at each
+//! silhouette vertex and a sheet along each silhouette edge (§2), built here on the CPU.
+//!
+//! Everything lives in the receiver plane's coordinates (u, v) plus the plateau parameter
+//! t ∈ [0, 1]: 0 on the hard shadow edge (the hither, darkest), 1 on the penumbra's outer rim
+//! (the yon, lit). Drawn with depth = t, the darkest primitive wins where they overlap (§2).
+
+use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
+
+use crate::scene::{EdgeAdjacency, NO_FACE};
+
+/// Fraction of the light's height above which a point casts nothing: its projection from the
+/// light would land behind the light (an anti-shadow). Such vertices get no cones or sheets,
+/// and the umbra's homogeneous clip (w = light height − point height > 0) drops their part.
+const ABOVE_LIGHT: f32 = 1e-4;
+/// Steepest angle from the plane's normal a base ellipse follows (85°): towards the horizon the
+/// true footprint grows without bound (a parabola, then a hyperbola).
+const MAX_TILT_TAN: f32 = 11.43;
+/// Bisection steps of the outer tangent (f32 resolution).
+const TANGENT_STEPS: u32 = 48;
+
+/// A receiver plane with an in-plane frame: height along `normal`, coordinates along `u`, `v`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReceiverPlane {
+    pub origin: Vec3,
+    pub normal: Vec3,
+    pub u: Vec3,
+    pub v: Vec3,
+}
+
+impl ReceiverPlane {
+    /// The ground y = `height`: u = +X, v = +Z.
+    pub fn ground(height: f32) -> Self {
+        ReceiverPlane { origin: Vec3::new(0.0, height, 0.0), normal: Vec3::Y, u: Vec3::X, v: Vec3::Z }
+    }
+
+    pub fn height(&self, p: Vec3) -> f32 {
+        (p - self.origin).dot(self.normal)
+    }
+
+    pub fn coords(&self, p: Vec3) -> Vec2 {
+        let d = p - self.origin;
+        Vec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    /// Where `p` lands, projected from the point `light` (Blinn); `None` unless `p` is below
+    /// the light.
+    pub fn project(&self, light: Vec3, p: Vec3) -> Option<Vec2> {
+        let (hl, hp) = (self.height(light), self.height(p));
+        if hp >= hl * (1.0 - ABOVE_LIGHT) {
+            return None;
+        }
+        Some(self.coords(light + (p - light) * (hl / (hl - hp))))
+    }
+
+    /// Blinn's planar projection ("Me and My (Fake) Shadow", 1988) in homogeneous form: world
+    /// point p ↦ (u·w, v·w, 0, w) with w = h(light) − h(p), so that points at or above the light
+    /// get w ≤ 0 and the GPU's clipper removes them instead of drawing an anti-shadow.
+    pub fn shadow_matrix(&self, light: Vec3) -> Mat4 {
+        let hl = self.height(light);
+        let n = self.normal;
+        // q·w = hl·p − h(p)·l, with h(p) = n·p − n·o, and w = hl − h(p).
+        let no = n.dot(self.origin);
+        let blinn = Mat4::from_cols(
+            (Vec3::X * hl - light * n.x).extend(-n.x),
+            (Vec3::Y * hl - light * n.y).extend(-n.y),
+            (Vec3::Z * hl - light * n.z).extend(-n.z),
+            (light * no).extend(hl + no),
+        );
+        // Plane coordinates of the homogeneous point: (q − o·w)·u, (q − o·w)·v, 0, w.
+        let to_plane = Mat4::from_cols(
+            Vec4::new(self.u.x, self.v.x, 0.0, 0.0),
+            Vec4::new(self.u.y, self.v.y, 0.0, 0.0),
+            Vec4::new(self.u.z, self.v.z, 0.0, 0.0),
+            Vec4::new(-self.origin.dot(self.u), -self.origin.dot(self.v), 0.0, 1.0),
+        );
+        to_plane * blinn
+    }
+}
+
+/// How big the penumbra of a vertex at height h is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PenumbraSize {
+    /// From the light sphere: the footprint on the plane of the cone of rays from the vertex to
+    /// the light (width W = D·h/(H − h) under a light overhead), times `scale` (the outer-only
+    /// plateau starts where the true penumbra is half way, see `PLATEAU_SCALE`).
+    Physical { scale: f32 },
+    /// Haines §3: radius = factor × height (0.1 in most of the paper's images).
+    Haines { factor: f32 },
+}
+
+/// The base of a vertex cone: an ellipse about the projected vertex (its apex),
+/// { centre + axes·x : |x| ≤ 1 }.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    pub centre: Vec2,
+    /// Columns: the semi-major axis (pointing away from the light) and the semi-minor axis.
+    pub axes: Mat2,
+}
+
+impl Cone {
+    /// The support function: max over the base of ν·x.
+    fn support(&self, nu: Vec2) -> f32 {
+        nu.dot(self.centre) + (self.axes.transpose() * nu).length()
+    }
+
+    /// The point of the base where the tangent with outward normal ν touches it.
+    fn support_point(&self, nu: Vec2) -> Vec2 {
+        let a = self.axes.transpose() * nu;
+        let len = a.length();
+        if len == 0.0 { self.centre } else { self.centre + self.axes * (a / len) }
+    }
+
+    pub fn is_point(&self) -> bool {
+        self.axes.col(0).length_squared() == 0.0 && self.axes.col(1).length_squared() == 0.0
+    }
+}
+
+/// The cone of vertex `p` under a light sphere (`light`, `radius`); `None` when `p` casts
+/// nothing (at or above the light). A vertex on or under the plane has a point base: a hard
+/// contact edge.
+pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: PenumbraSize, p: Vec3) -> Option<Cone> {
+    let centre = plane.project(light, p)?;
+    let h = plane.height(p);
+    if h <= 0.0 || radius == 0.0 && matches!(size, PenumbraSize::Physical { .. }) {
+        return Some(Cone { centre, axes: Mat2::ZERO });
+    }
+    match size {
+        PenumbraSize::Haines { factor } => Some(Cone { centre, axes: Mat2::from_diagonal(Vec2::splat(factor * h)) }),
+        PenumbraSize::Physical { scale } => {
+            // The rays from p towards the light sphere form a cone of half-angle α about the
+            // axis from the light through p, tilted θ from the plane's normal. Across the tilt
+            // its section spans h·tan(θ ± α); sideways about h·tan α / cos θ (§3's ellipse,
+            // major axis away from the light).
+            let axis = (p - plane.origin - (light - plane.origin)).normalize();
+            let away = Vec2::new(axis.dot(plane.u), axis.dot(plane.v));
+            let (sin_theta, major) = (away.length().min(1.0), away.try_normalize().unwrap_or(Vec2::X));
+            let theta = sin_theta.asin();
+            let alpha = (radius / (p - light).length()).min(1.0).asin();
+            let tan = |x: f32| x.tan().clamp(-MAX_TILT_TAN, MAX_TILT_TAN);
+            let far = if theta + alpha >= std::f32::consts::FRAC_PI_2 { MAX_TILT_TAN } else { tan(theta + alpha) };
+            let semi_major = 0.5 * h * (far - tan(theta - alpha));
+            let semi_minor = h * alpha.tan() / theta.cos().max(1.0 / MAX_TILT_TAN);
+            let minor = major.perp();
+            Some(Cone { centre, axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale) })
+        }
+    }
+}
+
+/// The common outer tangent of two cone bases on the side of the segment between their centres
+/// that `outward` points to: the touching points (on `a`, on `b`). `None` when one base holds
+/// the other on that side (there is no such tangent) or the centres coincide.
+pub fn outer_tangent(a: &Cone, b: &Cone, outward: Vec2) -> Option<(Vec2, Vec2)> {
+    let along = (b.centre - a.centre).try_normalize()?;
+    let side = if along.perp().dot(outward) >= 0.0 { along.perp() } else { -along.perp() };
+    // Tangent normals ν(δ) = side·cos δ + along·sin δ; on the common tangent both bases reach
+    // equally far: g(δ) = h_b(ν) − h_a(ν) = 0. g(−π/2) < 0 < g(π/2) unless one base holds the other.
+    let nu = |d: f32| side * d.cos() + along * d.sin();
+    let g = |d: f32| b.support(nu(d)) - a.support(nu(d));
+    let (mut lo, mut hi) = (-std::f32::consts::FRAC_PI_2, std::f32::consts::FRAC_PI_2);
+    if !(g(lo) < 0.0 && g(hi) > 0.0) {
+        return None;
+    }
+    for _ in 0..TANGENT_STEPS {
+        let mid = 0.5 * (lo + hi);
+        if g(mid) < 0.0 { lo = mid } else { hi = mid }
+    }
+    let n = nu(0.5 * (lo + hi));
+    Some((a.support_point(n), b.support_point(n)))
+}
+
+/// A plateau vertex: plane coordinates and the plateau parameter t (0 dark, 1 lit).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PlateauVertex {
+    pub u: f32,
+    pub v: f32,
+    pub t: f32,
+}
+
+impl PlateauVertex {
+    fn new(p: Vec2, t: f32) -> Self {
+        PlateauVertex { u: p.x, v: p.y, t }
+    }
+}
+
+/// Triangles of the plateau's sides, cones apart from sheets (the paper's two primitives, each
+/// its own timed pass).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlateauGeometry {
+    pub cones: Vec<PlateauVertex>,
+    pub sheets: Vec<PlateauVertex>,
+    /// Plane-space bounds of the shadow: the projected silhouette (the umbra's outline, even
+    /// when the penumbra has no width) and every cone and sheet.
+    pub footprint: Option<(Vec2, Vec2)>,
+}
+
+impl PlateauGeometry {
+    fn grow(&mut self, p: Vec2) {
+        self.footprint = Some(self.footprint.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))));
+    }
+
+    pub fn extend(&mut self, other: &PlateauGeometry) {
+        self.cones.extend_from_slice(&other.cones);
+        self.sheets.extend_from_slice(&other.sheets);
+        if let Some((lo, hi)) = other.footprint {
+            self.grow(lo);
+            self.grow(hi);
+        }
+    }
+
+    /// A cone as a triangle fan: apex at t = 0, base rim at t = 1.
+    fn push_cone(&mut self, cone: &Cone, segments: u32) {
+        if cone.is_point() {
+            return;
+        }
+        let rim = |k: u32| {
+            let a = std::f32::consts::TAU * k as f32 / segments as f32;
+            cone.centre + cone.axes * Vec2::new(a.cos(), a.sin())
+        };
+        for k in 0..segments {
+            self.cones.extend([
+                PlateauVertex::new(cone.centre, 0.0),
+                PlateauVertex::new(rim(k), 1.0),
+                PlateauVertex::new(rim(k + 1), 1.0),
+            ]);
+        }
+    }
+
+    /// The sheet between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1): a
+    /// Coons patch bounded by four lines, tessellated so that Gouraud interpolation of t over
+    /// each flat triangle strays from the bilinear patch by under 1% (paper Figure 4, §3).
+    fn push_sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2) {
+        let width = (ta - a).length().min((tb - b).length()).max((ta - a).length().max((tb - b).length()) * 1e-3);
+        if width == 0.0 {
+            return;
+        }
+        let twist = ((tb - ta) - (b - a)).length();
+        let n = ((twist / (0.04 * width)).sqrt().ceil() as usize).clamp(1, 32);
+        let at = |i: usize, j: usize| {
+            let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
+            PlateauVertex::new(a.lerp(b, s).lerp(ta.lerp(tb, s), t), t)
+        };
+        for i in 0..n {
+            for j in 0..n {
+                let (p00, p10, p01, p11) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
+                self.sheets.extend([p00, p10, p11, p00, p11, p01]);
+            }
+        }
+    }
+}
+
+/// What the plateau of one caster is built from.
+pub struct Caster<'a> {
+    /// World-space vertex positions.
+    pub positions: &'a [Vec3],
+    pub triangles: &'a [[u32; 3]],
+    pub adjacency: &'a EdgeAdjacency,
+}
+
+/// Where penumbra edges come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeSource {
+    /// Silhouette edges relative to the light, from the edge adjacency (closed meshes).
+    Silhouettes,
+    /// Every edge of every light-facing triangle: no connectivity needed (§3), what open meshes
+    /// get.
+    LightFacing,
+}
+
+/// The plateau settings of one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlateauLight {
+    pub position: Vec3,
+    pub radius: f32,
+    pub size: PenumbraSize,
+    /// Triangles per cone.
+    pub cone_segments: u32,
+}
+
+/// Which triangles face the light: computed once per face per frame.
+pub fn light_facing(caster: &Caster<'_>, light: Vec3) -> Vec<bool> {
+    caster
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| caster.positions[i as usize]);
+            (b - a).cross(c - a).dot(light - (a + b + c) / 3.0) > 0.0
+        })
+        .collect()
+}
+
+/// The edges that bound the light-facing part of the caster, each with the third vertex of its
+/// light-facing triangle (the umbra's inner side): silhouette edges between a light-facing and a
+/// back-facing triangle, boundary edges of light-facing triangles, or with
+/// [`EdgeSource::LightFacing`] every edge of every light-facing triangle.
+pub fn penumbra_edges(caster: &Caster<'_>, facing: &[bool], source: EdgeSource) -> Vec<([u32; 2], u32)> {
+    let third = |f: u32, e: [u32; 2]| caster.triangles[f as usize].into_iter().find(|v| !e.contains(v)).unwrap_or(e[0]);
+    match source {
+        EdgeSource::LightFacing => caster
+            .triangles
+            .iter()
+            .zip(facing)
+            .filter(|(_, f)| **f)
+            .flat_map(|(t, _)| [([t[0], t[1]], t[2]), ([t[1], t[2]], t[0]), ([t[2], t[0]], t[1])])
+            .collect(),
+        EdgeSource::Silhouettes => caster
+            .adjacency
+            .edges
+            .iter()
+            .filter_map(|e| {
+                let lit = |f: u32| f != NO_FACE && facing[f as usize];
+                let [f0, f1] = e.faces;
+                match (lit(f0), lit(f1)) {
+                    (true, false) => Some((e.vertices, third(f0, e.vertices))),
+                    (false, true) => Some((e.vertices, third(f1, e.vertices))),
+                    _ => None,
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Cones drawn this frame, by vertex: each silhouette vertex's cone is drawn once even when
+/// several edges share it (§3's mailbox).
+#[derive(Clone, Debug, Default)]
+pub struct Mailbox {
+    stamps: Vec<u64>,
+}
+
+impl Mailbox {
+    /// True the first time `vertex` is posted in `frame`.
+    pub fn first_visit(&mut self, vertex: u32, frame: u64) -> bool {
+        let i = vertex as usize;
+        if self.stamps.len() <= i {
+            self.stamps.resize(i + 1, u64::MAX);
+        }
+        std::mem::replace(&mut self.stamps[i], frame) != frame
+    }
+}
+
+/// The plateau sides of one caster: a cone per penumbra vertex (once, by `mailbox`) and a
+/// sheet along each penumbra edge, on its outer side.
+pub fn plateau_sides(
+    plane: &ReceiverPlane,
+    light: &PlateauLight,
+    caster: &Caster<'_>,
+    source: EdgeSource,
+    mailbox: &mut Mailbox,
+    frame: u64,
+) -> PlateauGeometry {
+    let facing = light_facing(caster, light.position);
+    let mut out = PlateauGeometry::default();
+    let cone = |v: u32| vertex_cone(plane, light.position, light.radius, light.size, caster.positions[v as usize]);
+    for ([a, b], inner) in penumbra_edges(caster, &facing, source) {
+        let (Some(ca), Some(cb)) = (cone(a), cone(b)) else { continue };
+        for (v, c) in [(a, &ca), (b, &cb)] {
+            if mailbox.first_visit(v, frame) {
+                out.push_cone(c, light.cone_segments);
+                out.grow(c.centre);
+            }
+        }
+        let Some(inside) = plane.project(light.position, caster.positions[inner as usize]) else { continue };
+        // Outward: away from the light-facing triangle's third vertex, across the edge.
+        let mid = 0.5 * (ca.centre + cb.centre);
+        let along = (cb.centre - ca.centre).normalize_or_zero();
+        let across = (mid - inside) - along * (mid - inside).dot(along);
+        if let Some((ta, tb)) = outer_tangent(&ca, &cb, across) {
+            out.push_sheet(ca.centre, cb.centre, ta, tb);
+        }
+    }
+    for p in out.cones.iter().chain(&out.sheets).map(|p| Vec2::new(p.u, p.v)).collect::<Vec<_>>() {
+        out.grow(p);
+    }
+    out
+}
