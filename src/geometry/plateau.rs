@@ -137,12 +137,14 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
             let axis = (p - plane.origin - (light - plane.origin)).normalize();
             let away = Vec2::new(axis.dot(plane.u), axis.dot(plane.v));
             let (sin_theta, major) = (away.length().min(1.0), away.try_normalize().unwrap_or(Vec2::X));
-            let theta = sin_theta.asin();
             let alpha = (radius / (p - light).length()).min(1.0).asin();
-            let tan = |x: f32| x.tan().clamp(-MAX_TILT_TAN, MAX_TILT_TAN);
-            let far = if theta + alpha >= std::f32::consts::FRAC_PI_2 { MAX_TILT_TAN } else { tan(theta + alpha) };
-            let semi_major = 0.5 * h * (far - tan(theta - alpha));
-            let semi_minor = h * alpha.tan() / theta.cos().max(1.0 / MAX_TILT_TAN);
+            // Past the cap the section keeps the shape it has there: tilt held so that its far
+            // side sits at the cap.
+            let cap = MAX_TILT_TAN.atan();
+            let theta = sin_theta.asin().min((cap - alpha).max(0.0));
+            let tan = |x: f32| x.min(cap).tan();
+            let semi_major = 0.5 * h * (tan(theta + alpha) - tan(theta - alpha));
+            let semi_minor = h * tan(alpha) / theta.cos();
             let minor = major.perp();
             Some(Cone { centre, axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale) })
         }
@@ -192,9 +194,11 @@ impl PlateauVertex {
 pub struct PlateauGeometry {
     pub cones: Vec<PlateauVertex>,
     pub sheets: Vec<PlateauVertex>,
-    /// Plane-space bounds of the shadow: the projected silhouette (the umbra's outline, even
-    /// when the penumbra has no width) and every cone and sheet.
+    /// Plane-space bounds of the shadow: the projected caster (the umbra, even when the
+    /// penumbra has no width) and every cone and sheet.
     pub footprint: Option<(Vec2, Vec2)>,
+    /// Part of a caster reaches the light's height: its umbra runs off to infinity.
+    pub unbounded: bool,
 }
 
 impl PlateauGeometry {
@@ -209,6 +213,7 @@ impl PlateauGeometry {
             self.grow(lo);
             self.grow(hi);
         }
+        self.unbounded |= other.unbounded;
     }
 
     /// A cone as a triangle fan: apex at t = 0, base rim at t = 1.
@@ -374,5 +379,175 @@ pub fn plateau_sides(
     for p in out.cones.iter().chain(&out.sheets).map(|p| Vec2::new(p.u, p.v)).collect::<Vec<_>>() {
         out.grow(p);
     }
+    for p in caster.positions {
+        match plane.project(light.position, *p) {
+            Some(q) => out.grow(q),
+            None => out.unbounded = true,
+        }
+    }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn circle(x: f32, y: f32, r: f32) -> Cone {
+        Cone { centre: Vec2::new(x, y), axes: Mat2::from_diagonal(Vec2::splat(r)) }
+    }
+
+    /// Distance from `p` to the line through `a` and `b`.
+    fn line_distance(p: Vec2, a: Vec2, b: Vec2) -> f32 {
+        ((b - a).perp_dot(p - a) / (b - a).length()).abs()
+    }
+
+    proptest! {
+        #[test]
+        fn the_blinn_matrix_is_the_projection(
+            p in (-5.0f32..5.0, 0.0f32..4.0, -5.0f32..5.0),
+            l in (-5.0f32..5.0, 5.0f32..20.0, -5.0f32..5.0),
+        ) {
+            let plane = ReceiverPlane::ground(0.5);
+            let (p, l) = (Vec3::from(p), Vec3::from(l));
+            let h = plane.shadow_matrix(l) * p.extend(1.0);
+            match plane.project(l, p) {
+                Some(q) => {
+                    prop_assert!(h.w > 0.0);
+                    prop_assert!((Vec2::new(h.x, h.y) / h.w - q).length() < 1e-3 * (1.0 + q.length()));
+                }
+                None => prop_assert!(h.w <= 1e-3 * l.y),
+            }
+        }
+
+        #[test]
+        fn outer_tangents_touch_both_circles(
+            r0 in 0.0f32..2.0, r1 in 0.0f32..2.0, d in 0.01f32..6.0, angle in 0.0f32..6.28,
+        ) {
+            let a = circle(0.3, -0.2, r0);
+            let b = circle(0.3 + d * angle.cos(), -0.2 + d * angle.sin(), r1);
+            let outward = (b.centre - a.centre).perp();
+            let tangent = outer_tangent(&a, &b, outward);
+            if d <= (r0 - r1).abs() * 0.999 {
+                prop_assert!(tangent.is_none(), "one circle holds the other: no outer tangent");
+            } else if d > (r0 - r1).abs() * 1.001 + 1e-3 {
+                let (ta, tb) = tangent.expect("separate circles have outer tangents");
+                prop_assert!(ta.is_finite() && tb.is_finite());
+                prop_assert!(((ta - a.centre).length() - r0).abs() < 1e-3 * (1.0 + r0));
+                prop_assert!(((tb - b.centre).length() - r1).abs() < 1e-3 * (1.0 + r1));
+                if (tb - ta).length() > 1e-2 {
+                    // The line is tangent to both: each centre is one radius away from it.
+                    prop_assert!((line_distance(a.centre, ta, tb) - r0).abs() < 2e-3 * (1.0 + d));
+                    prop_assert!((line_distance(b.centre, ta, tb) - r1).abs() < 2e-3 * (1.0 + d));
+                }
+                // On the outward side.
+                prop_assert!((ta - a.centre).dot(outward) >= -1e-4);
+            }
+        }
+
+        #[test]
+        fn sheets_tessellate_by_twist_with_t_in_range(r0 in 0.01f32..2.0, r1 in 0.01f32..2.0) {
+            let mut g = PlateauGeometry::default();
+            let (a, b) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1));
+            let (ta, tb) = outer_tangent(&a, &b, Vec2::Y).unwrap();
+            g.push_sheet(a.centre, b.centre, ta, tb);
+            prop_assert!(g.sheets.iter().all(|v| v.u.is_finite() && v.v.is_finite() && (0.0..=1.0).contains(&v.t)));
+            let quads = g.sheets.len() / 6;
+            if (r0 - r1).abs() < 1e-6 {
+                prop_assert_eq!(quads, 1, "equal radii: one flat quad");
+            }
+            // Twice the radius difference never needs fewer cells.
+            prop_assume!(r1 + (r1 - r0) > 0.0);
+            let mut wider = PlateauGeometry::default();
+            let (a2, b2) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1 + (r1 - r0)));
+            if let Some((ta2, tb2)) = outer_tangent(&a2, &b2, Vec2::Y) {
+                wider.push_sheet(a2.centre, b2.centre, ta2, tb2);
+                prop_assert!(wider.sheets.len() / 6 >= quads || (r1 - r0).abs() < 1e-3);
+            }
+        }
+
+        #[test]
+        fn silhouettes_of_a_closed_mesh_form_closed_loops(l in (-6.0f32..6.0, 2.0f32..12.0, -6.0f32..6.0)) {
+            let mesh = crate::scene::primitives::sphere(1.0).unwrap();
+            let positions: Vec<Vec3> = mesh.positions.iter().map(|p| *p + Vec3::Y * 1.5).collect();
+            let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let facing = light_facing(&caster, Vec3::from(l));
+            let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
+            prop_assert!(!edges.is_empty());
+            let mut degree = vec![0; positions.len()];
+            for ([a, b], inner) in &edges {
+                degree[*a as usize] += 1;
+                degree[*b as usize] += 1;
+                prop_assert!(*inner != *a && *inner != *b);
+            }
+            prop_assert!(degree.iter().all(|d| d % 2 == 0), "every silhouette vertex joins an even number of edges");
+        }
+    }
+
+    #[test]
+    fn the_mailbox_draws_each_cone_once() {
+        let mesh = crate::scene::primitives::cuboid(Vec3::ONE).unwrap();
+        let positions: Vec<Vec3> = mesh.positions.iter().map(|p| *p + Vec3::new(0.0, 2.0, 0.0)).collect();
+        let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let light = PlateauLight {
+            position: Vec3::new(2.0, 8.0, 1.0),
+            radius: 0.5,
+            size: PenumbraSize::Physical { scale: 1.0 },
+            cone_segments: 8,
+        };
+        let plane = ReceiverPlane::ground(0.0);
+        let mut mailbox = Mailbox::default();
+        let g = plateau_sides(&plane, &light, &caster, EdgeSource::Silhouettes, &mut mailbox, 1);
+        let edges = penumbra_edges(&caster, &light_facing(&caster, light.position), EdgeSource::Silhouettes);
+        let mut vertices: Vec<u32> = edges.iter().flat_map(|(e, _)| *e).collect();
+        vertices.sort();
+        vertices.dedup();
+        assert_eq!(g.cones.len(), vertices.len() * 8 * 3, "one cone per silhouette vertex");
+        assert_eq!(edges.len(), vertices.len(), "a convex silhouette is one loop");
+        // The next frame draws them again; the same frame does not.
+        assert!(mailbox.first_visit(vertices[0], 2) && !mailbox.first_visit(vertices[0], 2));
+    }
+
+    #[test]
+    fn cones_follow_the_light() {
+        let plane = ReceiverPlane::ground(0.0);
+        let size = PenumbraSize::Physical { scale: 1.0 };
+        let p = Vec3::new(0.0, 1.0, 0.0);
+        // Overhead: a circle of radius h·tan α = W/2.
+        let overhead = vertex_cone(&plane, Vec3::new(0.0, 11.0, 0.0), 0.5, size, p).unwrap();
+        let w = 2.0 * 0.5 * 1.0 / 10.0;
+        for axis in [overhead.axes.col(0).length(), overhead.axes.col(1).length()] {
+            assert!((axis - w / 2.0).abs() < 1e-3 * w, "{axis} vs {}", w / 2.0);
+        }
+        // Lower lights stretch the base away from the light; towards the horizon the stretch is
+        // capped at 85° from the normal, so it stays finite.
+        let first = overhead.axes.col(0).length();
+        for elevation in [30.0f32, 5.0, 1.0] {
+            let e = elevation.to_radians();
+            let light = Vec3::new(-10.0 * e.cos(), 1.0 + 10.0 * e.sin(), 0.0);
+            let cone = vertex_cone(&plane, light, 0.5, size, p).unwrap();
+            let (major, minor) = (cone.axes.col(0), cone.axes.col(1));
+            assert!(major.is_finite() && minor.is_finite() && cone.centre.is_finite());
+            assert!(major.length() >= minor.length() && major.length() > first, "{elevation}°");
+            assert!(major.length() <= MAX_TILT_TAN * p.y, "{elevation}°: capped");
+            assert!(major.x.abs() > 0.99 * major.length(), "the major axis points along the light's azimuth");
+        }
+        // Touching the plane: a point; at or above the light: nothing.
+        assert!(vertex_cone(&plane, Vec3::Y * 5.0, 0.5, size, Vec3::ZERO).unwrap().is_point());
+        assert!(vertex_cone(&plane, Vec3::Y * 5.0, 0.5, size, Vec3::Y * 5.0).is_none());
+        assert!(vertex_cone(&plane, Vec3::Y * 5.0, 0.5, size, Vec3::Y * 6.0).is_none());
+        // Haines' constant factor: radius = factor × height.
+        let haines = vertex_cone(&plane, Vec3::Y * 5.0, 0.5, PenumbraSize::Haines { factor: 0.1 }, p).unwrap();
+        assert!((haines.axes.col(0).length() - 0.1).abs() < 1e-6);
+    }
+
+    #[test]
+    fn nearly_equal_radii_make_a_nearly_flat_sheet() {
+        let (a, b) = (circle(0.0, 0.0, 1.0), circle(2.0, 0.0, 1.0 + 1e-6));
+        let (ta, tb) = outer_tangent(&a, &b, Vec2::Y).unwrap();
+        assert!((ta - Vec2::new(0.0, 1.0)).length() < 1e-4 && (tb - Vec2::new(2.0, 1.0)).length() < 1e-4);
+        // A point base inside the other circle: no outer tangent, no sheet, no NaN.
+        assert!(outer_tangent(&circle(0.0, 0.0, 2.0), &circle(0.5, 0.0, 0.0), Vec2::Y).is_none());
+        assert!(outer_tangent(&circle(0.0, 0.0, 0.0), &circle(0.0, 0.0, 1.0), Vec2::Y).is_none());
+    }
 }

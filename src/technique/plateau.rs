@@ -15,6 +15,10 @@
 //! default, measured against the reference, is [`PLATEAU_SCALE`]. `size_mode = 1` uses Haines'
 //! constant factor instead (radius = `haines_factor` × h).
 //!
+//! Casters reaching the light's height: the part at or above it casts nothing (no
+//! anti-shadows): its cones and sheets are skipped, and the umbra's homogeneous clip (w =
+//! light height − point height > 0) cuts it off, so the shadow of the rest runs to the horizon.
+//!
 //! Off the plane, receivers are unshadowed (`off_plane = 0`) or read the texture where the ray
 //! from the light through them meets the plane, the projected light map of §2 (`off_plane = 1`;
 //! casters themselves keep only their self-shadowing, since the map holds their own shadow).
@@ -266,6 +270,8 @@ impl Plateau {
     /// projected silhouette), cut to the visible receivers' extent on the plane.
     fn window(&self, plane: &ReceiverPlane, geometry: &PlateauGeometry, frame: &FrameInputs<'_>) -> Option<Vec4> {
         let (lo, hi) = geometry.footprint?;
+        // A caster reaching the light's height throws its umbra to infinity: all in view.
+        let (lo, hi) = if geometry.unbounded { (Vec2::MIN, Vec2::MAX) } else { (lo, hi) };
         let seen = frame.receivers_in_view.iter().map(|p| plane.coords(*p));
         let (seen_lo, seen_hi) = seen.fold((Vec2::MAX, Vec2::MIN), |(a, b), p| (a.min(p), b.max(p)));
         let (lo, hi) = (lo.max(seen_lo), hi.min(seen_hi));
