@@ -422,7 +422,7 @@ mod tests {
 
         #[test]
         fn outer_tangents_touch_both_circles(
-            r0 in 0.0f32..2.0, r1 in 0.0f32..2.0, d in 0.01f32..6.0, angle in 0.0f32..6.28,
+            r0 in 0.0f32..2.0, r1 in 0.0f32..2.0, d in 0.01f32..6.0, angle in 0.0f32..std::f32::consts::TAU,
         ) {
             let a = circle(0.3, -0.2, r0);
             let b = circle(0.3 + d * angle.cos(), -0.2 + d * angle.sin(), r1);
