@@ -235,3 +235,51 @@ fn the_error_against_the_reference_stays_under_its_bounds() {
     }
     finish(e);
 }
+
+#[test]
+fn open_meshes_and_off_plane_receivers() {
+    // An open box (no bottom): boundary edges switch the plateau to every light-facing polygon.
+    // Under it, a receiver that casts nothing, off the plane: unshadowed by default, shadowed by
+    // the projected light map with off_plane = 1.
+    let s = scene(
+        r#"
+[camera]
+position = [0.0, 12.0, 0.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+ortho_half_height = 3.0
+[light]
+position = [0.0, 9.0, 0.0]
+radius = 0.3
+[ground]
+height = 0.0
+[[object]]
+shape = "mesh"
+mesh = "../models/cube_no_bottom.obj"
+position = [-1.5, 2.5, 0.0]
+receives = false
+[[object]]
+shape = "box"
+size = [1.0, 0.2, 1.0]
+position = [1.5, 2.0, 0.0]
+receives = false
+[[object]]
+shape = "box"
+size = [2.0, 0.2, 2.0]
+position = [1.5, 0.4, 0.0]
+casts = false
+"#,
+    );
+    let mut e = engine();
+    let plain = render_with(&mut e, &s, "plateau", &[], 64);
+    // The open box's shadow on the ground, where the box does not hide it (x = −2.8).
+    assert_eq!(plain.visibility_at(2, 32), 0.0, "the open mesh casts an umbra");
+    assert!(plain.visibility_at(4, 60) > 0.99 && plain.visibility_at(60, 4) > 0.99);
+    // The slab 0.4 m up is off the plane: unshadowed, then under the light map (x = 2.25, past
+    // the small box that hides the middle of its shadow).
+    let slab = (56, 32);
+    assert_eq!(plain.visibility_at(slab.0, slab.1), 1.0);
+    let mapped = render_with(&mut e, &s, "plateau", &[("off_plane", "1")], 64);
+    assert!(mapped.visibility_at(slab.0, slab.1) < 0.05, "{}", mapped.visibility_at(slab.0, slab.1));
+    finish(e);
+}
