@@ -7,9 +7,8 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
-use softshadow::geometry::plateau::{
-    Caster, EdgeSource, Mailbox, PenumbraSize, PlateauLight, ReceiverPlane, light_facing, penumbra_edges, plateau_sides,
-};
+use softshadow::geometry::plateau::{PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
 use softshadow::scene::Mesh;
 
 fn plateau(c: &mut Criterion) {

@@ -3,6 +3,7 @@
 // falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
 #include "interface.glsl"
 #include "camera.glsl"
+#include "falloff.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
@@ -23,15 +24,6 @@ float plateau_t(vec2 tc) {
     float a = mix(texelFetch(plateau_texture, i, 0).r, texelFetch(plateau_texture, i + ivec2(1, 0), 0).r, f.x);
     float b = mix(texelFetch(plateau_texture, i + ivec2(0, 1), 0).r, texelFetch(plateau_texture, i + ivec2(1, 1), 0).r, f.x);
     return mix(a, b, f.y);
-}
-
-// The falloff row's value at t, interpolated between its 256 entries.
-float falloff_at(float t) {
-    float x = clamp(t, 0.0, 1.0) * 255.0;
-    int row = int(plateau.plane_u.w);
-    float lo = texelFetch(falloff, ivec2(int(floor(x)), row), 0).r;
-    float hi = texelFetch(falloff, ivec2(min(int(floor(x)) + 1, 255), row), 0).r;
-    return mix(lo, hi, fract(x));
 }
 
 void main() {
@@ -64,5 +56,5 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    out_visibility = falloff_at(plateau_t(tc));
+    out_visibility = falloff_at(falloff, int(plateau.plane_u.w), plateau_t(tc));
 }

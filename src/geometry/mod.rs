@@ -7,6 +7,7 @@ mod light_frustum;
 mod light_samples;
 pub mod plateau;
 mod projection;
+pub mod silhouette;
 
 pub use bounds::Aabb;
 pub use clip::{Hexahedron, intersection_points};

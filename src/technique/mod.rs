@@ -1,6 +1,7 @@
 //! Techniques: each owns its targets, pipelines and passes, and writes the visibility image V.
 //! A technique builds only what the scene in front of it needs.
 
+mod falloff;
 pub mod knobs;
 pub mod plateau;
 pub mod reference;

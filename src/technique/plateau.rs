@@ -26,19 +26,19 @@
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec2, Vec4};
-use gpu_allocator::MemoryLocation;
 
+use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::plateau::{
-    Caster, EdgeSource, Mailbox, PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane,
-    plateau_sides,
+    PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides,
 };
+use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Buffer, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen,
-    PerFrame, Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, copy_to_target, draw_vertices,
-    ensure, fullscreen, shaders, transition,
+    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, fullscreen, shaders,
+    transition,
 };
 use crate::gpu_types::PlateauView;
 
@@ -113,21 +113,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 };
 
 const PLATEAU_FORMAT: vk::Format = vk::Format::R16_UNORM;
-const FALLOFF_SIZE: u32 = 256;
 const CONE_SEGMENTS: u32 = 32;
-
-/// The three falloff curves, one row each, as R16 texels.
-fn falloff_texels() -> Vec<u16> {
-    let curves: [fn(f64) -> f64; 3] = [
-        |t| t,
-        |t| (1.0 + (std::f64::consts::PI * t - std::f64::consts::FRAC_PI_2).sin()) / 2.0,
-        |t| t * t * (3.0 - 2.0 * t),
-    ];
-    curves
-        .iter()
-        .flat_map(|f| (0..FALLOFF_SIZE).map(|i| (f(i as f64 / (FALLOFF_SIZE - 1) as f64) * 65535.0).round() as u16))
-        .collect()
-}
 
 /// What a caster's cached sides were built from: rebuilt only when any of it changes.
 #[derive(Clone, Debug, PartialEq)]
@@ -147,8 +133,7 @@ pub struct Plateau {
     vertices: Option<PerFrame>,
     texture: Option<Target>,
     depth: Option<Target>,
-    falloff: Option<Target>,
-    falloff_staging: Option<Buffer>,
+    falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
     sides: Vec<Option<(SidesKey, PlateauGeometry)>>,
     mailbox: Mailbox,
@@ -227,8 +212,7 @@ impl Plateau {
             vertices: None,
             texture: None,
             depth: None,
-            falloff: None,
-            falloff_staging: None,
+            falloff: Falloff::default(),
             sides: Vec::new(),
             mailbox: Mailbox::default(),
             frame: 0,
@@ -346,7 +330,7 @@ impl Technique for Plateau {
             v.write(frame.slot, bytes);
         }
         let cmd = frame.cmd;
-        self.upload_falloff(ctx, cmd)?;
+        let falloff = self.falloff.texture(ctx, cmd)?;
 
         let (texture, depth) = (self.texture.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));
         // umbra: cleared white (t = 1) and far, then the flattened casters at the hither.
@@ -384,7 +368,6 @@ impl Technique for Plateau {
         }
 
         frame.timer.begin(ctx, cmd, "resolve");
-        let falloff = self.falloff.as_mut().expect("uploaded");
         transition(
             ctx,
             cmd,
@@ -419,36 +402,7 @@ impl Technique for Plateau {
         }
         this.view.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
-        this.falloff_staging.into_iter().for_each(|b| b.destroy(ctx));
-        this.texture.into_iter().chain(this.depth).chain(this.falloff).for_each(|t| t.destroy(ctx));
-    }
-}
-
-impl Plateau {
-    /// Records the falloff curves' one-time upload (first frame only).
-    fn upload_falloff(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
-        if self.falloff.is_some() {
-            return Ok(());
-        }
-        let texels = falloff_texels();
-        let bytes: &[u8] = cast_slice(&texels);
-        let usage = vk::BufferUsageFlags::TRANSFER_SRC;
-        let mut staging = Buffer::new(ctx, "falloff staging", bytes.len() as u64, usage, MemoryLocation::CpuToGpu)?;
-        staging.write(0, bytes);
-        let desc =
-            TargetDesc::color("falloff", PLATEAU_FORMAT, FALLOFF_SIZE, 3).usage(vk::ImageUsageFlags::TRANSFER_DST);
-        let mut falloff = match Target::new(ctx, desc) {
-            Ok(t) => t,
-            Err(e) => {
-                staging.destroy(ctx);
-                return Err(e);
-            }
-        };
-        let range = vk::DescriptorBufferInfo { buffer: staging.buffer, offset: 0, range: bytes.len() as u64 };
-        copy_to_target(ctx, cmd, range, &mut falloff);
-        // The staging buffer lives until the technique is destroyed: the copy reads it later.
-        self.falloff_staging = Some(staging);
-        self.falloff = Some(falloff);
-        Ok(())
+        this.falloff.destroy(ctx);
+        this.texture.into_iter().chain(this.depth).for_each(|t| t.destroy(ctx));
     }
 }
