@@ -66,7 +66,13 @@ pub fn fit_spot_frustum(light: Vec3, aim: Vec3, casters: &[Vec3], receivers: &[V
     let pad_x = ((w[2] - w[0]) * 0.01).max(1e-6);
     let pad_y = ((w[3] - w[1]) * 0.01).max(1e-6);
     w = [w[0] - pad_x, w[1] - pad_y, w[2] + pad_x, w[3] + pad_y];
-    let far = far * 1.001;
+    // The depth range reaches the receivers too: a map may hold them (the smoothie's reads the
+    // receiver distance from it), and depth is linear in the colour target anyway.
+    let far = receiver_view.iter().map(|p| p.z).fold(far, f64::max) * 1.001;
+    Some(frustum(view, w, near, far))
+}
+
+fn frustum(view: DMat4, w: [f64; 4], near: f64, far: f64) -> LightFrustum {
     let (sx, sy) = (w[2] - w[0], w[3] - w[1]);
     let depth_scale = far / (far - near);
     let proj = DMat4::from_cols(
@@ -75,13 +81,24 @@ pub fn fit_spot_frustum(light: Vec3, aim: Vec3, casters: &[Vec3], receivers: &[V
         DVec4::new(-(w[0] + w[2]) / sx, -(w[1] + w[3]) / sy, depth_scale, 1.0),
         DVec4::new(0.0, 0.0, -near * depth_scale, 0.0),
     );
-    Some(LightFrustum {
+    LightFrustum {
         view: view.as_mat4(),
         view_proj: (proj * view).as_mat4(),
         window: w.map(|v| v as f32),
         near: near as f32,
         far: far as f32,
-    })
+    }
+}
+
+impl LightFrustum {
+    /// The same frustum with its window grown by `pad` tangent units on every side (geometry
+    /// drawn around the casters, such as smoothies), still within ±tan 80°.
+    pub fn grown(&self, pad: f32) -> LightFrustum {
+        let [x0, y0, x1, y1] = self.window.map(f64::from);
+        let pad = f64::from(pad);
+        let w = [(x0 - pad).max(-MAX_TAN), (y0 - pad).max(-MAX_TAN), (x1 + pad).min(MAX_TAN), (y1 + pad).min(MAX_TAN)];
+        frustum(self.view.as_dmat4(), w, f64::from(self.near), f64::from(self.far))
+    }
 }
 
 /// Bounds of x/z and y/z over points in front of the light; unbounded (±MAX_TAN) if one is not.

@@ -8,6 +8,7 @@ mod light_samples;
 pub mod plateau;
 mod projection;
 pub mod silhouette;
+pub mod smoothie;
 
 pub use bounds::Aabb;
 pub use clip::{Hexahedron, intersection_points};

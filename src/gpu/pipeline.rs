@@ -41,8 +41,8 @@ pub enum VertexInput {
     Position,
     /// `Vertex`: position (location 0) and normal (location 1).
     PositionNormal,
-    /// Three packed floats (location 0), 12 bytes apart: generated geometry.
-    Packed3,
+    /// Generated geometry: tightly packed floats, location i taking `floats[i]` of them.
+    Floats(&'static [u32]),
 }
 
 /// Depth test and write of a pipeline.
@@ -213,12 +213,26 @@ impl Pipeline {
                 offset: 12,
             },
         ];
+        let floats = if let VertexInput::Floats(f) = desc.vertex_input { f } else { &[] };
+        let mut packed_attrs = Vec::new();
+        let mut offset = 0;
+        for (location, &n) in floats.iter().enumerate() {
+            let format = [vk::Format::R32_SFLOAT, vk::Format::R32G32_SFLOAT, vk::Format::R32G32B32_SFLOAT]
+                [(n as usize).clamp(1, 3) - 1];
+            packed_attrs.push(vk::VertexInputAttributeDescription {
+                location: location as u32,
+                binding: 0,
+                format,
+                offset,
+            });
+            offset += 4 * n;
+        }
         let packed =
-            [vk::VertexInputBindingDescription { binding: 0, stride: 12, input_rate: vk::VertexInputRate::VERTEX }];
+            [vk::VertexInputBindingDescription { binding: 0, stride: offset, input_rate: vk::VertexInputRate::VERTEX }];
         let vertex_input = match desc.vertex_input {
-            VertexInput::Packed3 => vk::PipelineVertexInputStateCreateInfo::default()
+            VertexInput::Floats(_) => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&packed)
-                .vertex_attribute_descriptions(&attrs[..1]),
+                .vertex_attribute_descriptions(&packed_attrs),
             VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
             VertexInput::Position => vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&vb)

@@ -33,6 +33,7 @@ pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &crate::technique::shadow_map::PCF,
     &crate::technique::shadow_map::PCSS,
     &crate::technique::plateau::INFO,
+    &crate::technique::smoothie::INFO,
     &crate::technique::reference::INFO,
     &crate::technique::traced::RAYTRACE,
     &crate::technique::traced::PARKER,

@@ -6,6 +6,7 @@ pub mod knobs;
 pub mod plateau;
 pub mod reference;
 pub mod shadow_map;
+pub mod smoothie;
 pub mod traced;
 
 use ash::vk;
@@ -64,6 +65,7 @@ pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Tec
         }
         name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx)?)),
         name if name == plateau::INFO.name => Ok(Box::new(plateau::Plateau::new(ctx)?)),
+        name if name == smoothie::INFO.name => Ok(Box::new(smoothie::Smoothie::new(ctx)?)),
         name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
         name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),
         other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),

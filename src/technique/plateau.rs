@@ -166,7 +166,7 @@ impl Plateau {
                     vertex: shaders::PLATEAU_PENUMBRA_VERT,
                     fragment: shaders::PLATEAU_PENUMBRA_FRAG,
                     bindings: &[(Binding::Uniform, vertex)],
-                    vertex_input: VertexInput::Packed3,
+                    vertex_input: VertexInput::Floats(&[3]),
                     color_formats: &[PLATEAU_FORMAT],
                     depth,
                     blend: Blend::None,

@@ -66,7 +66,7 @@ pub struct Reference {
 
 impl Reference {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let depth = depth_pipeline(ctx)?;
+        let depth = depth_pipeline(ctx, vk::Format::R32_SFLOAT)?;
         let sampled = Binding::Sampled;
         let bindings = [Binding::Uniform, Binding::Storage, sampled, sampled, sampled];
         let accumulate = Pipeline::fullscreen(

@@ -136,8 +136,9 @@ pub const SHADOW_MAP_SIZE: Knob = Knob {
 /// Linear depth cleared beyond any caster: "nothing blocks this texel".
 pub(crate) const EMPTY_DEPTH: f32 = f32::MAX;
 
-/// Renders the casters' linear light depth (R32_SFLOAT) through the `LightView` at binding 0.
-pub(crate) fn depth_pipeline(ctx: &Context) -> Result<Pipeline> {
+/// Renders linear light depth (into `format`: R32 or R16 float) through the `LightView` at
+/// binding 0.
+pub(crate) fn depth_pipeline(ctx: &Context, format: vk::Format) -> Result<Pipeline> {
     Pipeline::new(
         ctx,
         &PipelineDesc {
@@ -149,7 +150,7 @@ pub(crate) fn depth_pipeline(ctx: &Context) -> Result<Pipeline> {
                 (Binding::Storage, vk::ShaderStageFlags::VERTEX),
             ],
             vertex_input: VertexInput::Position,
-            color_formats: &[vk::Format::R32_SFLOAT],
+            color_formats: &[format],
             depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
             blend: Blend::None,
             constants: &[],
@@ -159,13 +160,30 @@ pub(crate) fn depth_pipeline(ctx: &Context) -> Result<Pipeline> {
 
 /// Records every caster of the frame (inside a pass whose pipeline is bound).
 pub(crate) fn draw_casters(frame: &FrameInputs<'_>) {
-    for draw in frame.draws.iter().filter(|d| d.casts) {
+    draw_where(frame, |d| d.casts);
+}
+
+/// Records the frame's draws that `keep` selects.
+fn draw_where(frame: &FrameInputs<'_>, keep: impl Fn(&crate::renderer::Draw) -> bool) {
+    for draw in frame.draws.iter().filter(|d| keep(d)) {
         draw.record(frame.ctx, frame.cmd);
     }
 }
 
+/// What a shadow map holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapContents {
+    /// The casters: what blocks light.
+    Casters,
+    /// The casters and the ground: the receiver distance r a smoothie needs where no caster is
+    /// (Chan & Durand, Figure 11's pass 3 reads it from the map). The ground lies under every
+    /// caster, so it never blocks anything else.
+    CastersAndGround,
+}
+
 /// Pass 1: linear light-space depth of the casters through the fitted spot frustum.
 pub struct ShadowMapPass {
+    format: vk::Format,
     pipeline: Pipeline,
     light: PerFrame,
     map: Option<Target>,
@@ -173,8 +191,9 @@ pub struct ShadowMapPass {
 }
 
 impl ShadowMapPass {
-    pub fn new(ctx: &Context) -> Result<Self> {
-        let pipeline = depth_pipeline(ctx)?;
+    /// A pass rendering into `format` (R32_SFLOAT, or the smoothie paper's R16_SFLOAT).
+    pub fn new(ctx: &Context, format: vk::Format) -> Result<Self> {
+        let pipeline = depth_pipeline(ctx, format)?;
         let usage = vk::BufferUsageFlags::UNIFORM_BUFFER;
         let light =
             match PerFrame::new(ctx, "light view", std::mem::size_of::<LightView>() as u64, FRAMES_IN_FLIGHT, usage) {
@@ -184,7 +203,11 @@ impl ShadowMapPass {
                     return Err(e);
                 }
             };
-        Ok(ShadowMapPass { pipeline, light, map: None, depth: None })
+        Ok(ShadowMapPass { format, pipeline, light, map: None, depth: None })
+    }
+
+    pub fn format(&self) -> vk::Format {
+        self.format
     }
 
     /// Fits the frustum; `None` when no receiver in view can be shadowed (nothing to render).
@@ -208,9 +231,10 @@ impl ShadowMapPass {
         size: u32,
         bias: [f32; 3],
         filter: Vec4,
+        contents: MapContents,
     ) -> Result<()> {
         let ctx = frame.ctx;
-        ensure(ctx, &mut self.map, TargetDesc::color("shadow map", vk::Format::R32_SFLOAT, size, size))?;
+        ensure(ctx, &mut self.map, TargetDesc::color("shadow map", self.format, size, size))?;
         ensure(ctx, &mut self.depth, TargetDesc::depth("shadow map depth", size, size))?;
         let view = LightView {
             view: frustum.view,
@@ -236,7 +260,11 @@ impl ShadowMapPass {
             cmd,
             &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
         );
-        draw_casters(frame);
+        let ground = frame.scene.objects.len() as u32;
+        match contents {
+            MapContents::Casters => draw_casters(frame),
+            MapContents::CastersAndGround => draw_where(frame, |d| d.casts || d.instance == ground),
+        }
         pass.end(ctx, cmd);
         transition(ctx, cmd, &mut [(map, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
@@ -275,7 +303,7 @@ pub struct ShadowMap {
 
 impl ShadowMap {
     pub fn new(ctx: &Context, technique: &'static TechniqueInfo) -> Result<Self> {
-        Ok(ShadowMap { technique, pass: ShadowMapPass::new(ctx)?, resolves: Vec::new() })
+        Ok(ShadowMap { technique, pass: ShadowMapPass::new(ctx, vk::Format::R32_SFLOAT)?, resolves: Vec::new() })
     }
 
     /// Index in `resolves` of the pipeline for `filter`, made on first use.
@@ -317,7 +345,7 @@ impl Technique for ShadowMap {
         let size = params.get("shadow_map_size") as u32;
         let bias = ["depth_bias", "slope_bias", "normal_offset"].map(|k| params.get(k) as f32);
         let (filter, filter_params) = self.filter(params, frame, &frustum);
-        self.pass.record(frame, &frustum, size, bias, filter_params)?;
+        self.pass.record(frame, &frustum, size, bias, filter_params, MapContents::Casters)?;
 
         let (ctx, cmd) = (frame.ctx, frame.cmd);
         let index = self.resolve(ctx, filter)?;

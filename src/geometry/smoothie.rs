@@ -1,0 +1,203 @@
+//! Chan & Durand's smoothies ("Rendering Fake Soft Shadows with Smoothies", 2003) as pure
+//! geometry: at each silhouette edge a *smoothie edge*, the edge extended outward by t in the
+//! light's screen space, and at each silhouette vertex a *smoothie corner* (§3, Figure 2).
+//!
+//! Everything is in the light view's tangent plane (x/z, y/z), where the spot frustum's window
+//! is given. Each vertex carries the blocker's linear light depth b and shape coordinates whose
+//! length is the linear alpha: 0 on the silhouette, 1 at t (edges: distance from the edge / t;
+//! corners: |v − p| / t, Figure 6).
+//!
+//! Corners here are full squares of half-size t about the vertex with radial alpha, not the
+//! paper's wedges between two edges: they cover every direction around the vertex, so the §3
+//! special case (averaging normals at vertices with more than two silhouette edges) is never
+//! needed, and minimum blending keeps the overlap with the edges continuous.
+
+use glam::{Mat4, Vec2, Vec3};
+
+use super::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+
+/// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
+const MIN_DEPTH: f32 = 1e-6;
+
+/// One smoothie vertex.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SmoothieVertex {
+    /// Light-view tangent coordinates.
+    pub x: f32,
+    pub y: f32,
+    /// The blocker's linear light depth.
+    pub b: f32,
+    /// |shape| is the linear alpha.
+    pub sx: f32,
+    pub sy: f32,
+}
+
+/// The smoothie size t, in tangent units of the light view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SmoothieSize {
+    /// t = `scale` · R / b for a vertex at light depth b, R the light's radius: the angular
+    /// radius of the light seen from the blocker. With the remap α' = α / (1 − b/r) the alpha
+    /// then reaches 1 at (R/b)(1 − b/r) from the silhouette, the true outer half-penumbra of a
+    /// straight edge on a receiver at depth r (similar triangles).
+    Physical { light_radius: f32, scale: f32 },
+    /// The paper's user parameter: one t for every smoothie.
+    Fixed(f32),
+}
+
+impl SmoothieSize {
+    /// How far any smoothie between `near` and `far` reaches (see [`smoothies`]).
+    pub fn largest_reach(self, near: f32, far: f32) -> f32 {
+        self.at(near) * reach(near, far)
+    }
+
+    fn at(self, depth: f32) -> f32 {
+        match self {
+            SmoothieSize::Physical { light_radius, scale } => scale * light_radius / depth,
+            SmoothieSize::Fixed(t) => t,
+        }
+    }
+}
+
+/// Smoothie edges and corners, as triangle lists.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SmoothieGeometry {
+    pub edges: Vec<SmoothieVertex>,
+    pub corners: Vec<SmoothieVertex>,
+}
+
+impl SmoothieGeometry {
+    pub fn extend(&mut self, other: &SmoothieGeometry) {
+        self.edges.extend_from_slice(&other.edges);
+        self.corners.extend_from_slice(&other.corners);
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.edges.is_empty() && self.corners.is_empty()
+    }
+}
+
+/// The part of a smoothie at depth b that can matter: with the farthest receiver at `far`,
+/// α' = α / (1 − b/r) is already 1 for every receiver once α ≥ 1 − b/far, so the smoothie is cut
+/// there (its alpha unchanged). A far light then gets thin smoothies, not huge ones.
+fn reach(b: f32, far: f32) -> f32 {
+    (1.0 - b / far).clamp(0.0, 1.0)
+}
+
+fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
+    SmoothieVertex { x: p.x, y: p.y, b, sx: shape.x, sy: shape.y }
+}
+
+fn quad(out: &mut Vec<SmoothieVertex>, v: [SmoothieVertex; 4]) {
+    out.extend([v[0], v[1], v[2], v[0], v[2], v[3]]);
+}
+
+/// The silhouette edges of a caster relative to the light at `light` (boundary edges of open
+/// meshes count as silhouettes), each with the third vertex of its light-facing triangle.
+pub fn silhouette(caster: &Caster<'_>, light: Vec3) -> Vec<([u32; 2], u32)> {
+    penumbra_edges(caster, &light_facing(caster, light), EdgeSource::Silhouettes)
+}
+
+/// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (world →
+/// light view, +z away from the light), for receivers no farther than `far`. Each silhouette
+/// vertex gets one corner (`mailbox`).
+pub fn smoothies(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[([u32; 2], u32)],
+    (size, far): (SmoothieSize, f32),
+    mailbox: &mut Mailbox,
+    frame: u64,
+) -> SmoothieGeometry {
+    let project = |i: u32| {
+        let p = view.transform_point3(caster.positions[i as usize]);
+        (p.z > MIN_DEPTH).then(|| (Vec2::new(p.x, p.y) / p.z, p.z))
+    };
+    let mut out = SmoothieGeometry::default();
+    for &([a, b], inner) in edges {
+        let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
+        for (v, p, z) in [(a, pa, za), (b, pb, zb)] {
+            if mailbox.first_visit(v, frame) {
+                let (t, k) = (size.at(z), reach(z, far));
+                let c = |sx: f32, sy: f32| vertex(p + Vec2::new(sx, sy) * t * k, z, Vec2::new(sx, sy) * k);
+                quad(&mut out.corners, [c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0)]);
+            }
+        }
+        let Some(along) = (pb - pa).try_normalize() else { continue };
+        let Some((pi, _)) = project(inner) else { continue };
+        // Outward: away from the light-facing triangle, across the edge.
+        let normal = if along.perp().dot(pi - pa) > 0.0 { -along.perp() } else { along.perp() };
+        let (ka, kb) = (reach(za, far), reach(zb, far));
+        let (ta, tb) = (size.at(za) * ka, size.at(zb) * kb);
+        quad(
+            &mut out.edges,
+            [
+                vertex(pa, za, Vec2::ZERO),
+                vertex(pb, zb, Vec2::ZERO),
+                vertex(pb + normal * tb, zb, Vec2::X * kb),
+                vertex(pa + normal * ta, za, Vec2::X * ka),
+            ],
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn plate(height: f32) -> (Vec<Vec3>, crate::scene::Mesh) {
+        let mesh = crate::scene::primitives::cuboid(Vec3::new(1.0, 0.0, 1.0)).unwrap();
+        let positions = mesh.positions.iter().map(|p| *p + Vec3::Y * height).collect();
+        (positions, mesh)
+    }
+
+    /// Looking straight down from (0, 10, 0): tangent x = world x / depth, y = world z / depth.
+    fn down() -> Mat4 {
+        // View (x, y, z) = world (x, z, 10 − y).
+        Mat4::from_cols(glam::Vec4::X, -glam::Vec4::Z, glam::Vec4::Y, glam::Vec4::new(0.0, 0.0, 10.0, 1.0))
+    }
+
+    proptest! {
+        #[test]
+        fn edges_extend_outward_by_t_and_corners_are_radial(height in 0.5f32..5.0, t in 0.001f32..0.5) {
+            let (positions, mesh) = plate(height);
+            let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+            prop_assert_eq!(edges.len(), 4, "a plate under the light: its outline");
+            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), &mut Mailbox::default(), 1);
+            prop_assert_eq!(g.edges.len(), 4 * 6);
+            prop_assert_eq!(g.corners.len(), 4 * 6, "one corner per silhouette vertex");
+            let half = 0.5 / (10.0 - height);
+            for v in &g.edges {
+                let outer = v.sx == 1.0;
+                // The outline sits at ±half; the outer rim t further out, never inside.
+                let reach = v.x.abs().max(v.y.abs());
+                let expected = if outer { half + t } else { half };
+                prop_assert!((reach - expected).abs() < 1e-4 * (1.0 + expected), "{reach} vs {expected}");
+                prop_assert!((v.b - (10.0 - height)).abs() < 1e-3);
+            }
+            for v in &g.corners {
+                prop_assert!((Vec2::new(v.sx, v.sy).length() - 2f32.sqrt()).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn physical_size_is_the_light_s_angular_radius_from_the_blocker() {
+        let size = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0 };
+        assert!((size.at(5.0) - 0.1).abs() < 1e-7);
+        assert_eq!(SmoothieSize::Fixed(0.02).at(123.0), 0.02);
+    }
+
+    #[test]
+    fn vertices_behind_the_light_and_point_edges_are_skipped() {
+        let (positions, mesh) = plate(12.0); // above the light at y = 10
+        let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+        let g =
+            smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(0.1), f32::INFINITY), &mut Mailbox::default(), 1);
+        assert!(g.is_empty());
+    }
+}

@@ -1,0 +1,309 @@
+//! `smoothie`: Chan & Durand's fake soft shadows ("Rendering Fake Soft Shadows with Smoothies",
+//! 2003), on every receiver, casters included.
+//!
+//! Passes, in the paper's order: `shadow_map` (pass 1, the shared [`ShadowMapPass`], linear depth
+//! in R32F or the paper's 16-bit float, holding the casters and the ground so that pass 2 can read
+//! the receiver distance r), `smoothie_buffer` (the smoothie edges and corners drawn from the
+//! light into depth b and remapped alpha α' = α / (1 − b/r) at once, two targets with minimum
+//! blending), `resolve` (the two depth comparisons at the four nearest texels, then the falloff).
+//!
+//! Size: t = `t_scale` · R / b per vertex by default (see [`SmoothieSize::Physical`]); the
+//! `t` knob sets the paper's fixed screen-space t instead.
+//!
+//! Deviation: the smoothie buffer has no depth target. Minimum blending of b gives the nearest
+//! smoothie in any order, which a depth test would only give for the depth, not for the alpha
+//! that the paper also minimum-blends.
+
+use ash::vk;
+use bytemuck::cast_slice;
+use glam::{Mat4, Vec3, Vec4};
+
+use super::falloff::Falloff;
+use super::knobs::{Knob, Params, TechniqueInfo};
+use super::shadow_map::{EMPTY_DEPTH, MapContents, SHADOW_MAP_SIZE, ShadowMapPass};
+use super::{FrameInputs, Technique, clear_visibility};
+use crate::error::Result;
+use crate::geometry::silhouette::{Caster, Mailbox};
+use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
+use crate::gpu::{
+    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
+    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, fullscreen, shaders, transition,
+};
+
+/// t / (R / b) in the physical mode: what measured best against the reference (N = 256, 256²,
+/// linear falloff): RMSE on scenes/plate.toml 0.0405, 0.0397, 0.0403, 0.0522 for 0.25, 0.4, 0.5,
+/// 1; on scenes/sphere.toml 0.0416, 0.0436, 0.0449, 0.0537. Like the plateau, the smoothie only
+/// grows outward from the hard edge, where the true V is already ½.
+pub const SMOOTHIE_SCALE: f64 = 0.3;
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    offline: false,
+    name: "smoothie",
+    summary: "Chan & Durand's smoothies: shadow map + silhouette quads with remapped alpha, on every receiver",
+    knobs: &[
+        Knob { default: 1024.0, ..SHADOW_MAP_SIZE },
+        Knob {
+            name: "smoothie_size",
+            default: 1024.0,
+            min: 16.0,
+            max: 16384.0,
+            integer: true,
+            help: "smoothie buffer width and height, in texels",
+        },
+        Knob {
+            name: "t",
+            default: 0.0,
+            min: 0.0,
+            max: 1.0,
+            integer: false,
+            help: "smoothie size in the light's tangent units; 0: from the light radius (t_scale R / b)",
+        },
+        Knob {
+            name: "t_scale",
+            default: SMOOTHIE_SCALE,
+            min: 0.0,
+            max: 8.0,
+            integer: false,
+            help: "with t = 0: smoothie size as a multiple of the light's angular radius from the blocker",
+        },
+        Knob {
+            name: "depth16",
+            default: 0.0,
+            min: 0.0,
+            max: 1.0,
+            integer: true,
+            help: "1: the paper's 16-bit float shadow map; 0: 32-bit",
+        },
+        Knob {
+            name: "falloff",
+            default: 0.0,
+            min: 0.0,
+            max: 2.0,
+            integer: true,
+            help: "gradient: 0 linear, 1 sine, 2 smoothstep",
+        },
+    ],
+};
+
+const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+const ALPHA_FORMAT: vk::Format = vk::Format::R16_UNORM;
+/// Texel biases of the map: the `shadow-map` defaults.
+const BIAS: [f32; 3] = [1.0, 1.0, 1.5];
+
+/// What a caster's silhouette was found from: recomputed only when it changes.
+#[derive(Clone, Debug, PartialEq)]
+struct SilhouetteKey {
+    mesh: crate::scene::MeshId,
+    model: Mat4,
+    light: Vec3,
+}
+
+struct CasterSilhouette {
+    key: SilhouetteKey,
+    positions: Vec<Vec3>,
+    edges: Vec<([u32; 2], u32)>,
+}
+
+pub struct Smoothie {
+    pass: ShadowMapPass,
+    smoothie: Pipeline,
+    resolve: Pipeline,
+    vertices: Option<PerFrame>,
+    depth: Option<Target>,
+    alpha: Option<Target>,
+    falloff: Falloff,
+    silhouettes: Vec<Option<CasterSilhouette>>,
+    mailbox: Mailbox,
+    frame: u64,
+}
+
+impl Smoothie {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let pass = ShadowMapPass::new(ctx, DEPTH_FORMAT)?;
+        let pipelines = (|| {
+            let smoothie = Pipeline::new(
+                ctx,
+                &PipelineDesc {
+                    name: "smoothie_buffer",
+                    vertex: shaders::SMOOTHIE_SMOOTHIE_VERT,
+                    fragment: shaders::SMOOTHIE_SMOOTHIE_FRAG,
+                    bindings: &[
+                        (Binding::Uniform, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT),
+                        (Binding::Sampled, vk::ShaderStageFlags::FRAGMENT),
+                    ],
+                    vertex_input: VertexInput::Floats(&[3, 2]),
+                    color_formats: &[DEPTH_FORMAT, ALPHA_FORMAT],
+                    depth: None,
+                    blend: Blend::Min,
+                    constants: &[],
+                },
+            )?;
+            let b = [Binding::Uniform, Binding::Uniform];
+            let bindings = [&b[..], &[Binding::Sampled; 6]].concat();
+            let format = crate::renderer::VISIBILITY_FORMAT;
+            match Pipeline::fullscreen(
+                ctx,
+                &Fullscreen::new("resolve", shaders::SMOOTHIE_RESOLVE_FRAG, &bindings, format),
+            ) {
+                Ok(resolve) => Ok((smoothie, resolve)),
+                Err(e) => {
+                    smoothie.destroy(ctx);
+                    Err(e)
+                }
+            }
+        })();
+        let (smoothie, resolve) = match pipelines {
+            Ok(p) => p,
+            Err(e) => {
+                pass.destroy(ctx);
+                return Err(e);
+            }
+        };
+        Ok(Smoothie {
+            pass,
+            smoothie,
+            resolve,
+            vertices: None,
+            depth: None,
+            alpha: None,
+            falloff: Falloff::default(),
+            silhouettes: Vec::new(),
+            mailbox: Mailbox::default(),
+            frame: 0,
+        })
+    }
+
+    /// The smoothies of every caster through this frame's light view; silhouettes are found
+    /// again only for casters or a light that moved.
+    fn geometry(&mut self, frame: &FrameInputs<'_>, view: &Mat4, size: SmoothieSize, far: f32) -> SmoothieGeometry {
+        let objects = &frame.scene.objects;
+        let light = frame.scene.light.position;
+        self.silhouettes.resize_with(objects.len(), || None);
+        let mut out = SmoothieGeometry::default();
+        for (o, cached) in objects.iter().zip(&mut self.silhouettes) {
+            if !o.casts {
+                *cached = None;
+                continue;
+            }
+            let model = o.transform.matrix();
+            let key = SilhouetteKey { mesh: o.mesh.id(), model, light };
+            if cached.as_ref().is_none_or(|c| c.key != key) {
+                let positions: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
+                let caster =
+                    Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
+                let edges = silhouette(&caster, light);
+                *cached = Some(CasterSilhouette { key, positions, edges });
+            }
+            let c = cached.as_ref().expect("set above");
+            let caster = Caster { positions: &c.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
+            // Vertex numbers are per mesh: a fresh stamp per caster keeps the mailboxes apart.
+            self.frame += 1;
+            out.extend(&smoothies(view, &caster, &c.edges, (size, far), &mut self.mailbox, self.frame));
+        }
+        out
+    }
+}
+
+impl Technique for Smoothie {
+    fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()> {
+        let Some(frustum) = ShadowMapPass::fit(frame) else {
+            return clear_visibility(frame, visibility);
+        };
+        let t = params.get("t") as f32;
+        let smoothie_size = if t > 0.0 {
+            SmoothieSize::Fixed(t)
+        } else {
+            SmoothieSize::Physical { light_radius: frame.scene.light.radius, scale: params.get("t_scale") as f32 }
+        };
+        // Smoothies reach t beyond the casters' outline: the map and buffer must cover them.
+        let frustum = frustum.grown(smoothie_size.largest_reach(frustum.near, frustum.far));
+        let ctx = frame.ctx;
+        let format = if params.get("depth16") == 1.0 { vk::Format::R16_SFLOAT } else { DEPTH_FORMAT };
+        if self.pass.format() != format {
+            ctx.wait_idle()?;
+            let old = std::mem::replace(&mut self.pass, ShadowMapPass::new(ctx, format)?);
+            old.destroy(ctx);
+        }
+        let size = params.get("shadow_map_size") as u32;
+        let buffer_size = params.get("smoothie_size") as u32;
+        let kernel = Vec4::new(buffer_size as f32, params.get("falloff") as f32, 0.0, 0.0);
+        self.pass.record(frame, &frustum, size, BIAS, kernel, MapContents::CastersAndGround)?;
+
+        let geometry = self.geometry(frame, &frustum.view, smoothie_size, frustum.far);
+        let vertices: Vec<SmoothieVertex> = geometry.edges.iter().chain(&geometry.corners).copied().collect();
+        let bytes: &[u8] = cast_slice(&vertices);
+        if !bytes.is_empty() && self.vertices.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
+            // Grows only; the old buffer may still be read by the frame in flight.
+            ctx.wait_idle()?;
+            self.vertices.take().into_iter().for_each(|b| b.destroy(ctx));
+            let capacity = (bytes.len() as u64).next_power_of_two();
+            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+            self.vertices = Some(PerFrame::new(ctx, "smoothies", capacity, FRAMES_IN_FLIGHT, usage)?);
+        }
+        if let Some(v) = self.vertices.as_mut().filter(|_| !bytes.is_empty()) {
+            v.write(frame.slot, bytes);
+        }
+
+        ensure(ctx, &mut self.depth, TargetDesc::color("smoothie depth", DEPTH_FORMAT, buffer_size, buffer_size))?;
+        ensure(ctx, &mut self.alpha, TargetDesc::color("smoothie alpha", ALPHA_FORMAT, buffer_size, buffer_size))?;
+        let cmd = frame.cmd;
+        let falloff = self.falloff.texture(ctx, cmd)?;
+        let (depth, alpha) = (self.depth.as_mut().expect("ensured"), self.alpha.as_mut().expect("ensured"));
+        let (map, light) = self.pass.inputs(frame.slot);
+
+        frame.timer.begin(ctx, cmd, "smoothie_buffer");
+        transition(ctx, cmd, &mut [(depth, Access::COLOR_WRITE, true), (alpha, Access::COLOR_WRITE, true)]);
+        let pass = RenderPass::begin(
+            ctx,
+            cmd,
+            &[Attachment::clear_color(depth, [EMPTY_DEPTH; 4]), Attachment::clear_color(alpha, [1.0; 4])],
+            None,
+        );
+        if let Some(v) = &self.vertices {
+            self.smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)]);
+            draw_vertices(ctx, cmd, v.range(frame.slot), 0, vertices.len() as u32);
+        }
+        pass.end(ctx, cmd);
+        frame.timer.end(ctx, cmd);
+
+        frame.timer.begin(ctx, cmd, "resolve");
+        transition(
+            ctx,
+            cmd,
+            &mut [
+                (depth, Access::FRAGMENT_READ, false),
+                (alpha, Access::FRAGMENT_READ, false),
+                (falloff, Access::FRAGMENT_READ, false),
+                (visibility, Access::COLOR_WRITE, true),
+            ],
+        );
+        fullscreen(
+            ctx,
+            cmd,
+            &self.resolve,
+            visibility,
+            &[
+                Descriptor::Buffer(frame.globals),
+                Descriptor::Buffer(light),
+                Descriptor::Image(frame.depth),
+                Descriptor::Image(frame.normal),
+                Descriptor::Image(map),
+                Descriptor::Image(depth),
+                Descriptor::Image(alpha),
+                Descriptor::Image(falloff),
+            ],
+        );
+        frame.timer.end(ctx, cmd);
+        Ok(())
+    }
+
+    fn destroy(self: Box<Self>, ctx: &Context) {
+        let this = *self;
+        this.pass.destroy(ctx);
+        this.smoothie.destroy(ctx);
+        this.resolve.destroy(ctx);
+        this.vertices.into_iter().for_each(|b| b.destroy(ctx));
+        this.depth.into_iter().chain(this.alpha).for_each(|t| t.destroy(ctx));
+        this.falloff.destroy(ctx);
+    }
+}
