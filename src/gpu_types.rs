@@ -63,8 +63,19 @@ pub struct PlateauView {
     pub window: Vec4,
 }
 
+/// One caster's silhouette dispatch, padded to 256 bytes (see `LightSample`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SilhouetteParams {
+    pub model_view: Mat4,
+    pub size: Vec4,
+    pub counts: [u32; 4],
+    pub pad: [Vec4; 10],
+}
+
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
 const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
+const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);

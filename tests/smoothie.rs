@@ -173,3 +173,22 @@ fn the_error_against_the_reference_stays_under_its_bounds() {
     }
     finish(e);
 }
+
+#[test]
+fn the_compute_path_draws_the_same_smoothies_as_the_cpu() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
+    let mut e = engine();
+    // The default scene (meshes and primitives, several casters) and the plate (a closed
+    // zero-thickness mesh).
+    for name in ["default", "plate"] {
+        let s = Scene::load(format!("{dir}{name}.toml")).unwrap();
+        let cpu = render_with(&mut e, &s, "smoothie", &[], 96);
+        for _ in 0..3 {
+            // Several frames: the mailbox stamps must not carry over.
+            let gpu = render_with(&mut e, &s, "smoothie", &[("gpu_silhouettes", "1")], 96);
+            let m = Metrics::between(&gpu, &cpu).unwrap();
+            assert!(m.max_abs < 0.01, "{name}: {m:?}");
+        }
+    }
+    finish(e);
+}

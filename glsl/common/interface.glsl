@@ -51,4 +51,13 @@ struct PlateauView {
     vec4 window;        // u0, v0, u1, v1: the part of the plane the texture covers
 };
 
+// One caster's silhouette dispatch (glsl/smoothie/silhouettes.comp). 256 bytes, so an array of
+// them can be bound one element at a time as a uniform buffer.
+struct SilhouetteParams {
+    mat4 model_view;  // object -> light view (+z away from the light)
+    vec4 size;        // x: t, or scale * light radius when y = 1 (t = x / depth); z: farthest receiver
+    uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices
+    vec4 pad[10];
+};
+
 #endif

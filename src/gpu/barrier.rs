@@ -113,3 +113,42 @@ fn is_write(access: vk::AccessFlags2) -> bool {
             | vk::AccessFlags2::TRANSFER_WRITE,
     )
 }
+
+/// One side of a memory dependency on buffers: a stage and what it does there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BufferAccess {
+    pub stage: vk::PipelineStageFlags2,
+    pub access: vk::AccessFlags2,
+}
+
+impl BufferAccess {
+    /// Written by `vkCmdUpdateBuffer` (a copy-stage transfer).
+    pub const TRANSFER_WRITE: BufferAccess =
+        BufferAccess { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
+    /// Read and written (atomics, appends) by a compute shader.
+    pub const COMPUTE_READ_WRITE: BufferAccess = BufferAccess {
+        stage: vk::PipelineStageFlags2::COMPUTE_SHADER,
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::SHADER_STORAGE_READ.as_raw() | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
+        ),
+    };
+    /// Generated geometry drawn indirectly: the vertices and the draw's arguments.
+    pub const INDIRECT_DRAW: BufferAccess = BufferAccess {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::DRAW_INDIRECT.as_raw() | vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT.as_raw(),
+        ),
+        access: vk::AccessFlags2::from_raw(
+            vk::AccessFlags2::INDIRECT_COMMAND_READ.as_raw() | vk::AccessFlags2::VERTEX_ATTRIBUTE_READ.as_raw(),
+        ),
+    };
+}
+
+/// Orders buffer accesses: everything `before` did is finished and visible to `after`.
+pub fn buffer_barrier(ctx: &Context, cmd: vk::CommandBuffer, before: BufferAccess, after: BufferAccess) {
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(before.stage)
+        .src_access_mask(before.access)
+        .dst_stage_mask(after.stage)
+        .dst_access_mask(after.access)];
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
+}

@@ -132,9 +132,12 @@ impl Context {
         let (physical, props) = pick_device(instance, options.device.as_deref())?;
         let queue_family = unsafe { instance.get_physical_device_queue_family_properties(physical) }
             .iter()
-            .position(|q| q.queue_flags.contains(vk::QueueFlags::GRAPHICS) && q.timestamp_valid_bits > 0)
-            .ok_or_else(|| Error::NoDevice(format!("{}: no graphics queue with timestamps", name_of(&props))))?
-            as u32;
+            .position(|q| {
+                q.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) && q.timestamp_valid_bits > 0
+            })
+            .ok_or_else(|| {
+                Error::NoDevice(format!("{}: no graphics and compute queue with timestamps", name_of(&props)))
+            })? as u32;
         let timestamp_valid_bits = unsafe { instance.get_physical_device_queue_family_properties(physical) }
             [queue_family as usize]
             .timestamp_valid_bits;
@@ -143,7 +146,12 @@ impl Context {
         let queue_ci =
             [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
         let device_ext = [ash::khr::push_descriptor::NAME.as_ptr()];
-        let mut v13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        // maintenance4 (required of every Vulkan 1.3 device) lets SPIR-V 1.6 compute shaders
+        // declare their workgroup size with LocalSizeId, as shaderc emits it.
+        let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(true)
+            .synchronization2(true)
+            .maintenance4(true);
         let device_ci = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_ci)
             .enabled_extension_names(&device_ext)

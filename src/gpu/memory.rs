@@ -57,6 +57,11 @@ impl Buffer {
         slice[offset as usize..offset as usize + bytes.len()].copy_from_slice(bytes);
     }
 
+    /// All of the buffer, as a descriptor range.
+    pub fn range(&self) -> vk::DescriptorBufferInfo {
+        vk::DescriptorBufferInfo { buffer: self.buffer, offset: 0, range: self.size }
+    }
+
     /// The mapped contents of a host-visible buffer.
     pub fn read(&self) -> &[u8] {
         self.allocation.as_ref().and_then(Allocation::mapped_slice).expect("host-visible buffer")

@@ -13,12 +13,12 @@ mod target;
 mod timestamps;
 mod upload;
 
-pub use barrier::{Access, copy_to_host, transition};
+pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
 pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Binding, Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, VertexInput};
-pub use render::{Attachment, RenderPass, draw_vertices, fullscreen};
+pub use render::{Attachment, RenderPass, dispatch, draw_indirect, draw_vertices, fullscreen, update_buffer};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{copy_to_target, upload};

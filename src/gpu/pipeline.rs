@@ -112,14 +112,60 @@ pub struct Pipeline {
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
     bindings: Vec<Binding>,
+    bind_point: vk::PipelineBindPoint,
 }
 
 impl Pipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc<'_>) -> Result<Self> {
+        let mut pipeline = Pipeline::with_set_layout(ctx, desc.name, desc.bindings, vk::PipelineBindPoint::GRAPHICS)?;
+        // On failure, `destroy` releases what was made so far (null handles are ignored).
+        if let Err(e) = pipeline.build(ctx, desc) {
+            pipeline.destroy(ctx);
+            return Err(e);
+        }
+        ctx.name(pipeline.pipeline, desc.name);
+        Ok(pipeline)
+    }
+
+    /// A compute pipeline whose shader reads and writes `bindings`.
+    pub fn compute(ctx: &Context, name: &'static str, shader: &[u32], bindings: &[Binding]) -> Result<Self> {
+        let bindings: Vec<_> = bindings.iter().map(|b| (*b, vk::ShaderStageFlags::COMPUTE)).collect();
+        let mut pipeline = Pipeline::with_set_layout(ctx, name, &bindings, vk::PipelineBindPoint::COMPUTE)?;
+        let built = (|| {
+            let set_layouts = [pipeline.set_layout];
+            let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+            pipeline.layout =
+                unsafe { ctx.device.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")?;
+            let module = shader_module(ctx, shader)?;
+            let stage = vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::COMPUTE)
+                .module(module)
+                .name(c"main");
+            let ci = vk::ComputePipelineCreateInfo::default().stage(stage).layout(pipeline.layout);
+            let created = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[ci], None) };
+            unsafe { ctx.device.destroy_shader_module(module, None) };
+            pipeline.pipeline =
+                created.map_err(|(_, result)| Error::Vulkan { call: "vkCreateComputePipelines", result })?[0];
+            Ok(())
+        })();
+        if let Err(e) = built {
+            pipeline.destroy(ctx);
+            return Err(e);
+        }
+        ctx.name(pipeline.pipeline, name);
+        Ok(pipeline)
+    }
+
+    /// The pipeline shell: its push-descriptor set layout, no layout or pipeline yet.
+    fn with_set_layout(
+        ctx: &Context,
+        name: &'static str,
+        bindings: &[(Binding, vk::ShaderStageFlags)],
+        bind_point: vk::PipelineBindPoint,
+    ) -> Result<Self> {
         let d = &ctx.device;
         let samplers = [ctx.nearest_sampler];
-        let layout_bindings: Vec<_> = desc
-            .bindings
+        let layout_bindings: Vec<_> = bindings
             .iter()
             .enumerate()
             .map(|(i, (b, stages))| {
@@ -135,20 +181,14 @@ impl Pipeline {
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&layout_bindings);
         let set_layout = unsafe { d.create_descriptor_set_layout(&set_ci, None) }.vk("vkCreateDescriptorSetLayout")?;
-        let mut pipeline = Pipeline {
-            name: desc.name,
+        Ok(Pipeline {
+            name,
             pipeline: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
             set_layout,
-            bindings: desc.bindings.iter().map(|(b, _)| *b).collect(),
-        };
-        // On failure, `destroy` releases what was made so far (null handles are ignored).
-        if let Err(e) = pipeline.build(ctx, desc) {
-            pipeline.destroy(ctx);
-            return Err(e);
-        }
-        ctx.name(pipeline.pipeline, desc.name);
-        Ok(pipeline)
+            bindings: bindings.iter().map(|(b, _)| *b).collect(),
+            bind_point,
+        })
     }
 
     /// A full-screen pass (`glsl/common/fullscreen.vert`) as `desc` describes it.
@@ -331,8 +371,8 @@ impl Pipeline {
             })
             .collect();
         unsafe {
-            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            ctx.push_descriptor.cmd_push_descriptor_set(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &writes);
+            ctx.device.cmd_bind_pipeline(cmd, self.bind_point, self.pipeline);
+            ctx.push_descriptor.cmd_push_descriptor_set(cmd, self.bind_point, self.layout, 0, &writes);
         }
     }
 

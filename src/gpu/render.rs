@@ -125,3 +125,27 @@ pub fn draw_vertices(
         ctx.device.cmd_draw(cmd, count, 1, first, 0);
     }
 }
+
+/// Draws the vertices of `vertices` as many as the `VkDrawIndirectCommand` at `args` says
+/// (geometry a compute shader generated), with the bound pipeline.
+pub fn draw_indirect(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    vertices: vk::DescriptorBufferInfo,
+    args: vk::DescriptorBufferInfo,
+) {
+    unsafe {
+        ctx.device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.buffer], &[vertices.offset]);
+        ctx.device.cmd_draw_indirect(cmd, args.buffer, args.offset, 1, 16);
+    }
+}
+
+/// Runs the bound compute pipeline over `groups` workgroups.
+pub fn dispatch(ctx: &Context, cmd: vk::CommandBuffer, groups: u32) {
+    unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
+}
+
+/// Writes `data` (at most 64 KiB, a multiple of 4 bytes) into `dst` from the command buffer.
+pub fn update_buffer(ctx: &Context, cmd: vk::CommandBuffer, dst: vk::DescriptorBufferInfo, data: &[u8]) {
+    unsafe { ctx.device.cmd_update_buffer(cmd, dst.buffer, dst.offset, data) };
+}

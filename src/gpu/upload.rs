@@ -29,12 +29,22 @@ pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFla
             dst.buffer,
             &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size }],
         );
-        // Later frames read the data as vertices and indices: order them after the copy.
+        // Later frames read the data as vertices and indices, or compute shaders read and write
+        // it: order them after the copy.
         let barrier = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
             .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-            .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT | vk::PipelineStageFlags2::INDEX_INPUT)
-            .dst_access_mask(vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::INDEX_READ)];
+            .dst_stage_mask(
+                vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT
+                    | vk::PipelineStageFlags2::INDEX_INPUT
+                    | vk::PipelineStageFlags2::COMPUTE_SHADER,
+            )
+            .dst_access_mask(
+                vk::AccessFlags2::VERTEX_ATTRIBUTE_READ
+                    | vk::AccessFlags2::INDEX_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_READ
+                    | vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            )];
         ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
     });
     staging.destroy(ctx);

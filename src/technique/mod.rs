@@ -7,6 +7,7 @@ pub mod plateau;
 pub mod reference;
 pub mod shadow_map;
 pub mod smoothie;
+mod smoothie_gpu;
 pub mod traced;
 
 use ash::vk;

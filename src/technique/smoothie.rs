@@ -21,13 +21,15 @@ use glam::{Mat4, Vec3, Vec4};
 use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::shadow_map::{EMPTY_DEPTH, MapContents, SHADOW_MAP_SIZE, ShadowMapPass};
+use super::smoothie_gpu::GpuSilhouettes;
 use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
 use crate::geometry::silhouette::{Caster, Mailbox};
 use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
-    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, fullscreen, shaders, transition,
+    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_indirect, draw_vertices, ensure, fullscreen,
+    shaders, transition,
 };
 
 /// t / (R / b) in the physical mode: what measured best against the reference (N = 256, 256²,
@@ -82,6 +84,14 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             integer: true,
             help: "gradient: 0 linear, 1 sine, 2 smoothstep",
         },
+        Knob {
+            name: "gpu_silhouettes",
+            default: 0.0,
+            min: 0.0,
+            max: 1.0,
+            integer: true,
+            help: "1: silhouettes and smoothies in a compute shader, drawn indirectly; 0: on the CPU",
+        },
     ],
 };
 
@@ -115,6 +125,8 @@ pub struct Smoothie {
     silhouettes: Vec<Option<CasterSilhouette>>,
     mailbox: Mailbox,
     frame: u64,
+    /// The compute path, made when first asked for.
+    gpu: Option<GpuSilhouettes>,
 }
 
 impl Smoothie {
@@ -170,6 +182,7 @@ impl Smoothie {
             silhouettes: Vec::new(),
             mailbox: Mailbox::default(),
             frame: 0,
+            gpu: None,
         })
     }
 
@@ -229,20 +242,34 @@ impl Technique for Smoothie {
         let kernel = Vec4::new(buffer_size as f32, params.get("falloff") as f32, 0.0, 0.0);
         self.pass.record(frame, &frustum, size, BIAS, kernel, MapContents::CastersAndGround)?;
 
-        let geometry = self.geometry(frame, &frustum.view, smoothie_size, frustum.far);
-        let vertices: Vec<SmoothieVertex> = geometry.edges.iter().chain(&geometry.corners).copied().collect();
-        let bytes: &[u8] = cast_slice(&vertices);
-        if !bytes.is_empty() && self.vertices.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
-            // Grows only; the old buffer may still be read by the frame in flight.
-            ctx.wait_idle()?;
-            self.vertices.take().into_iter().for_each(|b| b.destroy(ctx));
-            let capacity = (bytes.len() as u64).next_power_of_two();
-            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-            self.vertices = Some(PerFrame::new(ctx, "smoothies", capacity, FRAMES_IN_FLIGHT, usage)?);
-        }
-        if let Some(v) = self.vertices.as_mut().filter(|_| !bytes.is_empty()) {
-            v.write(frame.slot, bytes);
-        }
+        // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
+        let source = if params.get("gpu_silhouettes") == 1.0 {
+            if self.gpu.is_none() {
+                self.gpu = Some(GpuSilhouettes::new(ctx)?);
+            }
+            let gpu = self.gpu.as_mut().expect("made above");
+            let (vertices, args) = gpu.record(frame, &frustum.view, smoothie_size, frustum.far)?;
+            Smoothies::Indirect { vertices, args }
+        } else {
+            let geometry = self.geometry(frame, &frustum.view, smoothie_size, frustum.far);
+            let vertices: Vec<SmoothieVertex> = geometry.edges.iter().chain(&geometry.corners).copied().collect();
+            let bytes: &[u8] = cast_slice(&vertices);
+            if !bytes.is_empty() && self.vertices.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
+                // Grows only; the old buffer may still be read by the frame in flight.
+                ctx.wait_idle()?;
+                self.vertices.take().into_iter().for_each(|b| b.destroy(ctx));
+                let capacity = (bytes.len() as u64).next_power_of_two();
+                let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+                self.vertices = Some(PerFrame::new(ctx, "smoothies", capacity, FRAMES_IN_FLIGHT, usage)?);
+            }
+            match self.vertices.as_mut().filter(|_| !bytes.is_empty()) {
+                Some(v) => {
+                    v.write(frame.slot, bytes);
+                    Smoothies::Direct { vertices: v.range(frame.slot), count: vertices.len() as u32 }
+                }
+                None => Smoothies::None,
+            }
+        };
 
         ensure(ctx, &mut self.depth, TargetDesc::color("smoothie depth", DEPTH_FORMAT, buffer_size, buffer_size))?;
         ensure(ctx, &mut self.alpha, TargetDesc::color("smoothie alpha", ALPHA_FORMAT, buffer_size, buffer_size))?;
@@ -259,9 +286,11 @@ impl Technique for Smoothie {
             &[Attachment::clear_color(depth, [EMPTY_DEPTH; 4]), Attachment::clear_color(alpha, [1.0; 4])],
             None,
         );
-        if let Some(v) = &self.vertices {
-            self.smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)]);
-            draw_vertices(ctx, cmd, v.range(frame.slot), 0, vertices.len() as u32);
+        self.smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)]);
+        match source {
+            Smoothies::Direct { vertices, count } => draw_vertices(ctx, cmd, vertices, 0, count),
+            Smoothies::Indirect { vertices, args } => draw_indirect(ctx, cmd, vertices, args),
+            Smoothies::None => {}
         }
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
@@ -305,5 +334,13 @@ impl Technique for Smoothie {
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
         this.depth.into_iter().chain(this.alpha).for_each(|t| t.destroy(ctx));
         this.falloff.destroy(ctx);
+        this.gpu.into_iter().for_each(|g| g.destroy(ctx));
     }
+}
+
+/// Where this frame's smoothie vertices are.
+enum Smoothies {
+    Direct { vertices: vk::DescriptorBufferInfo, count: u32 },
+    Indirect { vertices: vk::DescriptorBufferInfo, args: vk::DescriptorBufferInfo },
+    None,
 }

@@ -1,0 +1,46 @@
+//! Per-frame CPU cost of the smoothie's geometry on the largest shipped model (wingnut, 6090
+//! triangles, 9135 edges): silhouette extraction (face facing once per face, then every edge)
+//! and the smoothie edges and corners of one light view.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{Mat4, Vec3, Vec4};
+use softshadow::geometry::silhouette::{Caster, Mailbox};
+use softshadow::geometry::smoothie::{SmoothieSize, silhouette, smoothies};
+use softshadow::scene::Mesh;
+
+fn smoothie(c: &mut Criterion) {
+    let wingnut = Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/wingnut.obj")).unwrap();
+    let positions: Vec<Vec3> = wingnut.positions.iter().map(|p| *p + Vec3::Y).collect();
+    let caster = Caster { positions: &positions, triangles: &wingnut.triangles, adjacency: &wingnut.adjacency };
+    let light = Vec3::new(3.0, 9.0, 2.5);
+    let mut group = c.benchmark_group("smoothie, wingnut");
+    group.throughput(Throughput::Elements(wingnut.adjacency.edges.len() as u64));
+    group.bench_function("silhouette edges", |b| b.iter(|| silhouette(black_box(&caster), light)));
+    let edges = silhouette(&caster, light);
+    // A light view looking from the light at the model.
+    let forward = (Vec3::Y - light).normalize();
+    let right = Vec3::Y.cross(forward).normalize();
+    let up = forward.cross(right);
+    let view = Mat4::from_cols(
+        Vec4::new(right.x, up.x, forward.x, 0.0),
+        Vec4::new(right.y, up.y, forward.y, 0.0),
+        Vec4::new(right.z, up.z, forward.z, 0.0),
+        Vec4::new(-right.dot(light), -up.dot(light), -forward.dot(light), 1.0),
+    );
+    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, 20.0);
+    let mut mailbox = Mailbox::default();
+    let mut frame = 0;
+    group.bench_function("smoothie geometry", |b| {
+        b.iter(|| {
+            frame += 1;
+            smoothies(&view, black_box(&caster), &edges, size, &mut mailbox, frame)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, smoothie);
+criterion_main!(benches);

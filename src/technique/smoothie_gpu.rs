@@ -1,0 +1,216 @@
+//! The smoothie's silhouettes on the GPU (`gpu_silhouettes = 1`), beyond the paper, whose
+//! hardware could not feed a shader's output back into a vertex array (§6): one compute
+//! invocation per edge finds silhouettes and appends smoothie edges and corners
+//! (`glsl/smoothie/silhouettes.comp`); the smoothie pass draws them with an indirect draw.
+//! Each mesh's positions, triangles, edges and mailbox stamps are uploaded once.
+
+use ash::vk;
+use bytemuck::{bytes_of, cast_slice};
+use glam::{Mat4, Vec4};
+
+use super::FrameInputs;
+use crate::error::Result;
+use crate::geometry::smoothie::SmoothieSize;
+use crate::gpu::{
+    Binding, Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, buffer_barrier, dispatch,
+    shaders, update_buffer, upload,
+};
+use crate::gpu_types::SilhouetteParams;
+use crate::scene::{Mesh, MeshId};
+
+const GROUP: u32 = 64;
+const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
+/// Bytes per smoothie vertex: x, y, b, sx, sy.
+const VERTEX_BYTES: u64 = 20;
+
+/// One mesh's connectivity on the GPU.
+struct MeshBuffers {
+    positions: Buffer,
+    triangles: Buffer,
+    edges: Buffer,
+    stamps: Buffer,
+    edge_count: u32,
+}
+
+impl MeshBuffers {
+    fn new(ctx: &Context, mesh: &Mesh) -> Result<Self> {
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let positions: Vec<Vec4> = mesh.positions.iter().map(|p| p.extend(1.0)).collect();
+        let triangles: Vec<[u32; 4]> = mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
+        let edges: Vec<[u32; 4]> =
+            mesh.adjacency.edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]).collect();
+        let stamps = vec![0u32; mesh.positions.len()];
+        let mut made: Vec<Buffer> = Vec::new();
+        for (name, bytes) in [
+            ("silhouette positions", cast_slice::<Vec4, u8>(&positions)),
+            ("silhouette triangles", cast_slice(&triangles)),
+            ("silhouette edges", cast_slice(&edges)),
+            ("silhouette stamps", cast_slice(&stamps)),
+        ] {
+            match upload(ctx, name, bytes, storage) {
+                Ok(b) => made.push(b),
+                Err(e) => {
+                    made.into_iter().for_each(|b| b.destroy(ctx));
+                    return Err(e);
+                }
+            }
+        }
+        let [positions, triangles, edges, stamps] = <[Buffer; 4]>::try_from(made).ok().expect("four buffers");
+        Ok(MeshBuffers { positions, triangles, edges, stamps, edge_count: mesh.adjacency.edges.len() as u32 })
+    }
+
+    fn destroy(self, ctx: &Context) {
+        for b in [self.positions, self.triangles, self.edges, self.stamps] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+/// The compute path's pipeline and buffers.
+pub struct GpuSilhouettes {
+    pipeline: Pipeline,
+    meshes: Vec<(MeshId, MeshBuffers)>,
+    params: Option<PerFrame>,
+    vertices: Option<PerFrame>,
+    args: PerFrame,
+    stamp: u32,
+}
+
+/// Grows `buffer` to hold `bytes` per frame (waiting for the GPU first: frames in flight may
+/// still read the old one).
+fn ensure_capacity(
+    ctx: &Context,
+    buffer: &mut Option<PerFrame>,
+    name: &str,
+    bytes: u64,
+    usage: vk::BufferUsageFlags,
+) -> Result<()> {
+    if buffer.as_ref().is_none_or(|b| b.capacity() < bytes) {
+        ctx.wait_idle()?;
+        buffer.take().into_iter().for_each(|b| b.destroy(ctx));
+        *buffer = Some(PerFrame::new(ctx, name, bytes.next_power_of_two(), FRAMES_IN_FLIGHT, usage)?);
+    }
+    Ok(())
+}
+
+impl GpuSilhouettes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let s = Binding::Storage;
+        let pipeline = Pipeline::compute(
+            ctx,
+            "silhouettes",
+            shaders::SMOOTHIE_SILHOUETTES_COMP,
+            &[Binding::Uniform, s, s, s, s, s, s],
+        )?;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::INDIRECT_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_DST;
+        match PerFrame::new(ctx, "smoothie draw", 16, FRAMES_IN_FLIGHT, usage) {
+            Ok(args) => {
+                Ok(GpuSilhouettes { pipeline, meshes: Vec::new(), params: None, vertices: None, args, stamp: 0 })
+            }
+            Err(e) => {
+                pipeline.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Records the silhouette dispatches of every caster seen through `view`; returns the
+    /// vertex buffer and the indirect draw arguments the smoothie pass draws from.
+    pub fn record(
+        &mut self,
+        frame: &mut FrameInputs<'_>,
+        view: &Mat4,
+        size: SmoothieSize,
+        far: f32,
+    ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
+        let ctx = frame.ctx;
+        let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
+        for o in &casters {
+            if !self.meshes.iter().any(|(id, _)| *id == o.mesh.id()) {
+                self.meshes.push((o.mesh.id(), MeshBuffers::new(ctx, &o.mesh)?));
+            }
+        }
+        let capacity: u64 =
+            casters.iter().map(|o| 6 * (o.mesh.adjacency.edges.len() + o.mesh.positions.len()) as u64).sum();
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        ensure_capacity(
+            ctx,
+            &mut self.vertices,
+            "smoothies",
+            capacity.max(1) * VERTEX_BYTES,
+            storage | vk::BufferUsageFlags::VERTEX_BUFFER,
+        )?;
+        let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
+        ensure_capacity(
+            ctx,
+            &mut self.params,
+            "silhouette params",
+            params_bytes,
+            vk::BufferUsageFlags::UNIFORM_BUFFER,
+        )?;
+
+        let (scale, physical) = match size {
+            SmoothieSize::Physical { light_radius, scale } => (light_radius * scale, 1.0),
+            SmoothieSize::Fixed(t) => (t, 0.0),
+        };
+        let mut params = Vec::with_capacity(casters.len());
+        for o in &casters {
+            self.stamp = self.stamp.wrapping_add(1).max(1);
+            params.push(SilhouetteParams {
+                model_view: *view * o.transform.matrix(),
+                size: Vec4::new(scale, physical, far, 0.0),
+                counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, 0],
+                pad: [Vec4::ZERO; 10],
+            });
+        }
+        let params_buffer = self.params.as_mut().expect("ensured");
+        params_buffer.write(frame.slot, cast_slice(&params));
+        let (params_range, vertices, args) = (
+            params_buffer.range(frame.slot),
+            self.vertices.as_ref().expect("ensured").range(frame.slot),
+            self.args.range(frame.slot),
+        );
+        let args = vk::DescriptorBufferInfo { range: 16, ..args };
+
+        let cmd = frame.cmd;
+        frame.timer.begin(ctx, cmd, "silhouettes");
+        // Earlier frames' dispatches stamped the same meshes: finish them before this frame's.
+        buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
+        update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0]));
+        buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
+        for (i, o) in casters.iter().enumerate() {
+            let mesh = &self.meshes.iter().find(|(id, _)| *id == o.mesh.id()).expect("uploaded above").1;
+            let one = vk::DescriptorBufferInfo {
+                buffer: params_range.buffer,
+                offset: params_range.offset + i as u64 * PARAMS_BYTES,
+                range: PARAMS_BYTES,
+            };
+            self.pipeline.bind(
+                ctx,
+                cmd,
+                &[
+                    Descriptor::Buffer(one),
+                    Descriptor::Buffer(mesh.positions.range()),
+                    Descriptor::Buffer(mesh.triangles.range()),
+                    Descriptor::Buffer(mesh.edges.range()),
+                    Descriptor::Buffer(mesh.stamps.range()),
+                    Descriptor::Buffer(args),
+                    Descriptor::Buffer(vertices),
+                ],
+            );
+            dispatch(ctx, cmd, mesh.edge_count.div_ceil(GROUP));
+        }
+        buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
+        frame.timer.end(ctx, cmd);
+        Ok((vertices, args))
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+        self.meshes.into_iter().for_each(|(_, m)| m.destroy(ctx));
+        self.params.into_iter().chain(self.vertices).for_each(|b| b.destroy(ctx));
+        self.args.destroy(ctx);
+    }
+}
