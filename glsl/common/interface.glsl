@@ -31,6 +31,7 @@ struct LightView {
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
     vec4 kernel;     // PCF: taps, kernel radius, 1 = radius in world units (0 = texels), unused
                      // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
+                     // smoothie: buffer size, falloff row, ground height, light height
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the

@@ -19,19 +19,18 @@ layout(set = 0, binding = 7) uniform sampler2D falloff;
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// The smoothie test at the four texels around uv, bilinearly weighted.
+// The smoothie test at the four texels around uv, bilinearly weighted: one gather each of
+// depth and alpha.
 float smoothie_test(vec2 uv, float depth) {
     float size = light.kernel.x;
     vec2 pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
-    ivec2 i = ivec2(floor(pos));
     vec2 f = fract(pos);
-    float v[4];
-    for (int k = 0; k < 4; k++) {
-        ivec2 texel = i + ivec2(k & 1, k >> 1);
-        float b = texelFetch(smoothie_depth, texel, 0).r;
-        v[k] = depth > b ? texelFetch(smoothie_alpha, texel, 0).r : 1.0;
-    }
-    return mix(mix(v[0], v[1], f.x), mix(v[2], v[3], f.x), f.y);
+    vec2 corner = (floor(pos) + 1.0) / size;
+    // Gather order: (i0,j1) (i1,j1) (i1,j0) (i0,j0).
+    vec4 b = textureGather(smoothie_depth, corner, 0);
+    vec4 a = textureGather(smoothie_alpha, corner, 0);
+    vec4 v = mix(vec4(1.0), a, vec4(greaterThan(vec4(depth), b)));
+    return mix(mix(v.w, v.z, f.x), mix(v.x, v.y, f.x), f.y);
 }
 
 void main() {
@@ -50,6 +49,8 @@ void main() {
         return;
     }
     float umbra = compare_bilinear(shadow_map, vec2(0.0), light.bias.w, l.uv, l.depth);
-    float penumbra = smoothie_test(l.uv, l.depth);
-    out_visibility = falloff_at(falloff, int(light.kernel.y), min(umbra, penumbra));
+    // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
+    // falloff texture.
+    float v = umbra > 0.0 ? min(umbra, smoothie_test(l.uv, l.depth)) : 0.0;
+    out_visibility = v > 0.0 && v < 1.0 ? falloff_at(falloff, int(light.kernel.y), v) : v;
 }

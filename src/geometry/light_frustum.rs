@@ -66,8 +66,8 @@ pub fn fit_spot_frustum(light: Vec3, aim: Vec3, casters: &[Vec3], receivers: &[V
     let pad_x = ((w[2] - w[0]) * 0.01).max(1e-6);
     let pad_y = ((w[3] - w[1]) * 0.01).max(1e-6);
     w = [w[0] - pad_x, w[1] - pad_y, w[2] + pad_x, w[3] + pad_y];
-    // The depth range reaches the receivers too: a map may hold them (the smoothie's reads the
-    // receiver distance from it), and depth is linear in the colour target anyway.
+    // The depth range reaches the receivers too: `far` is then the farthest receiver, which
+    // bounds how far a smoothie can matter; depth is linear in the colour target anyway.
     let far = receiver_view.iter().map(|p| p.z).fold(far, f64::max) * 1.001;
     Some(frustum(view, w, near, far))
 }

@@ -160,25 +160,9 @@ pub(crate) fn depth_pipeline(ctx: &Context, format: vk::Format) -> Result<Pipeli
 
 /// Records every caster of the frame (inside a pass whose pipeline is bound).
 pub(crate) fn draw_casters(frame: &FrameInputs<'_>) {
-    draw_where(frame, |d| d.casts);
-}
-
-/// Records the frame's draws that `keep` selects.
-fn draw_where(frame: &FrameInputs<'_>, keep: impl Fn(&crate::renderer::Draw) -> bool) {
-    for draw in frame.draws.iter().filter(|d| keep(d)) {
+    for draw in frame.draws.iter().filter(|d| d.casts) {
         draw.record(frame.ctx, frame.cmd);
     }
-}
-
-/// What a shadow map holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MapContents {
-    /// The casters: what blocks light.
-    Casters,
-    /// The casters and the ground: the receiver distance r a smoothie needs where no caster is
-    /// (Chan & Durand, Figure 11's pass 3 reads it from the map). The ground lies under every
-    /// caster, so it never blocks anything else.
-    CastersAndGround,
 }
 
 /// Pass 1: linear light-space depth of the casters through the fitted spot frustum.
@@ -231,7 +215,6 @@ impl ShadowMapPass {
         size: u32,
         bias: [f32; 3],
         filter: Vec4,
-        contents: MapContents,
     ) -> Result<()> {
         let ctx = frame.ctx;
         ensure(ctx, &mut self.map, TargetDesc::color("shadow map", self.format, size, size))?;
@@ -260,11 +243,7 @@ impl ShadowMapPass {
             cmd,
             &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
         );
-        let ground = frame.scene.objects.len() as u32;
-        match contents {
-            MapContents::Casters => draw_casters(frame),
-            MapContents::CastersAndGround => draw_where(frame, |d| d.casts || d.instance == ground),
-        }
+        draw_casters(frame);
         pass.end(ctx, cmd);
         transition(ctx, cmd, &mut [(map, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
@@ -345,7 +324,7 @@ impl Technique for ShadowMap {
         let size = params.get("shadow_map_size") as u32;
         let bias = ["depth_bias", "slope_bias", "normal_offset"].map(|k| params.get(k) as f32);
         let (filter, filter_params) = self.filter(params, frame, &frustum);
-        self.pass.record(frame, &frustum, size, bias, filter_params, MapContents::Casters)?;
+        self.pass.record(frame, &frustum, size, bias, filter_params)?;
 
         let (ctx, cmd) = (frame.ctx, frame.cmd);
         let index = self.resolve(ctx, filter)?;

@@ -2,10 +2,15 @@
 //! 2003), on every receiver, casters included.
 //!
 //! Passes, in the paper's order: `shadow_map` (pass 1, the shared [`ShadowMapPass`], linear depth
-//! in R32F or the paper's 16-bit float, holding the casters and the ground so that pass 2 can read
-//! the receiver distance r), `smoothie_buffer` (the smoothie edges and corners drawn from the
-//! light into depth b and remapped alpha α' = α / (1 − b/r) at once, two targets with minimum
-//! blending), `resolve` (the two depth comparisons at the four nearest texels, then the falloff).
+//! in R32F or the paper's 16-bit float), `smoothie_buffer` (the smoothie edges and corners drawn
+//! from the light into depth b and remapped alpha α' = α / (1 − b/r) at once, two targets with
+//! minimum blending), `resolve` (the two depth comparisons at the four nearest texels, then the
+//! falloff).
+//!
+//! r, the receiver's distance behind a smoothie texel, is the nearer of the casters' depth in
+//! the map (as Figure 11 reads it) and the ground plane's along the texel's ray, computed
+//! exactly: the paper's map held every surface, ours holds the casters, so receivers that cast
+//! nothing never block light.
 //!
 //! Size: t = `t_scale` · R / b per vertex by default (see [`SmoothieSize::Physical`]); the
 //! `t` knob sets the paper's fixed screen-space t instead.
@@ -20,7 +25,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
-use super::shadow_map::{EMPTY_DEPTH, MapContents, SHADOW_MAP_SIZE, ShadowMapPass};
+use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
 use super::{FrameInputs, Technique, clear_visibility};
 use crate::error::Result;
@@ -239,8 +244,11 @@ impl Technique for Smoothie {
         }
         let size = params.get("shadow_map_size") as u32;
         let buffer_size = params.get("smoothie_size") as u32;
-        let kernel = Vec4::new(buffer_size as f32, params.get("falloff") as f32, 0.0, 0.0);
-        self.pass.record(frame, &frustum, size, BIAS, kernel, MapContents::CastersAndGround)?;
+        // The ground's height (none: infinitely far below) and the light's, for r in pass 2.
+        let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
+        let light_y = frame.scene.light.position.y;
+        let kernel = Vec4::new(buffer_size as f32, params.get("falloff") as f32, ground, light_y);
+        self.pass.record(frame, &frustum, size, BIAS, kernel)?;
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
         let source = if params.get("gpu_silhouettes") == 1.0 {
