@@ -73,6 +73,22 @@ pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Tec
     }
 }
 
+/// The `resolve` pass every technique ends with: V overwritten by the full-screen `pipeline`
+/// reading `inputs` (already made readable).
+pub(crate) fn resolve(
+    frame: &mut FrameInputs<'_>,
+    pipeline: &crate::gpu::Pipeline,
+    visibility: &mut Target,
+    inputs: &[crate::gpu::Descriptor<'_>],
+) {
+    use crate::gpu::{Access, fullscreen, transition};
+    let (ctx, cmd) = (frame.ctx, frame.cmd);
+    frame.timer.begin(ctx, cmd, "resolve");
+    transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
+    fullscreen(ctx, cmd, pipeline, visibility, inputs);
+    frame.timer.end(ctx, cmd);
+}
+
 /// Writes V = 1 everywhere: the scene in view has nothing that can shadow a receiver, so no
 /// technique targets or passes are needed this frame.
 pub(crate) fn clear_visibility(frame: &mut FrameInputs<'_>, visibility: &mut Target) -> Result<()> {

@@ -29,7 +29,7 @@ use glam::{Mat4, Vec2, Vec4};
 
 use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility};
+use super::{FrameInputs, Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::geometry::plateau::{
     PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides,
@@ -37,8 +37,7 @@ use crate::geometry::plateau::{
 use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, fullscreen, shaders,
-    transition,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, shaders, transition,
 };
 use crate::gpu_types::PlateauView;
 
@@ -367,31 +366,16 @@ impl Technique for Plateau {
             frame.timer.end(ctx, cmd);
         }
 
-        frame.timer.begin(ctx, cmd, "resolve");
-        transition(
-            ctx,
-            cmd,
-            &mut [
-                (texture, Access::FRAGMENT_READ, false),
-                (falloff, Access::FRAGMENT_READ, false),
-                (visibility, Access::COLOR_WRITE, true),
-            ],
-        );
-        fullscreen(
-            ctx,
-            cmd,
-            &self.resolve,
-            visibility,
-            &[
-                Descriptor::Buffer(frame.globals),
-                Descriptor::Buffer(view_range),
-                Descriptor::Image(frame.depth),
-                Descriptor::Image(frame.normal),
-                Descriptor::Image(texture),
-                Descriptor::Image(falloff),
-            ],
-        );
-        frame.timer.end(ctx, cmd);
+        transition(ctx, cmd, &mut [(texture, Access::FRAGMENT_READ, false), (falloff, Access::FRAGMENT_READ, false)]);
+        let inputs = [
+            Descriptor::Buffer(frame.globals),
+            Descriptor::Buffer(view_range),
+            Descriptor::Image(frame.depth),
+            Descriptor::Image(frame.normal),
+            Descriptor::Image(texture),
+            Descriptor::Image(falloff),
+        ];
+        resolve(frame, &self.resolve, visibility, &inputs);
         Ok(())
     }
 

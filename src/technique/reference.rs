@@ -19,12 +19,12 @@ use glam::{Vec3, Vec4};
 
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, depth_pipeline, draw_casters};
-use super::{FrameInputs, Technique, clear_visibility};
+use super::{FrameInputs, Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Milestones, PerFrame,
-    Pipeline, RenderPass, Target, TargetDesc, ensure, fullscreen, shaders, transition,
+    Pipeline, RenderPass, Target, TargetDesc, ensure, shaders, transition,
 };
 use crate::gpu_types::{LightSample, LightView};
 
@@ -232,10 +232,7 @@ impl Technique for Reference {
         transition(ctx, cmd, &mut [(sums, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
 
-        frame.timer.begin(ctx, cmd, "resolve");
-        transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
-        fullscreen(ctx, cmd, &self.resolve, visibility, &[Descriptor::Image(sums)]);
-        frame.timer.end(ctx, cmd);
+        resolve(frame, &self.resolve, visibility, &[Descriptor::Image(sums)]);
         Ok(())
     }
 

@@ -14,12 +14,12 @@ use bytemuck::bytes_of;
 use glam::{Vec3, Vec4};
 
 use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility};
+use super::{FrameInputs, Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, fullscreen, shaders, transition,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, shaders, transition,
 };
 use crate::gpu_types::LightView;
 
@@ -326,26 +326,16 @@ impl Technique for ShadowMap {
         let (filter, filter_params) = self.filter(params, frame, &frustum);
         self.pass.record(frame, &frustum, size, bias, filter_params)?;
 
-        let (ctx, cmd) = (frame.ctx, frame.cmd);
-        let index = self.resolve(ctx, filter)?;
-        let resolve = &self.resolves[index].1;
+        let index = self.resolve(frame.ctx, filter)?;
         let (map, light) = self.pass.inputs(frame.slot);
-        frame.timer.begin(ctx, cmd, "resolve");
-        transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
-        fullscreen(
-            ctx,
-            cmd,
-            resolve,
-            visibility,
-            &[
-                Descriptor::Buffer(frame.globals),
-                Descriptor::Buffer(light),
-                Descriptor::Image(frame.depth),
-                Descriptor::Image(frame.normal),
-                Descriptor::Image(map),
-            ],
-        );
-        frame.timer.end(ctx, cmd);
+        let inputs = [
+            Descriptor::Buffer(frame.globals),
+            Descriptor::Buffer(light),
+            Descriptor::Image(frame.depth),
+            Descriptor::Image(frame.normal),
+            Descriptor::Image(map),
+        ];
+        resolve(frame, &self.resolves[index].1, visibility, &inputs);
         Ok(())
     }
 

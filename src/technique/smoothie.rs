@@ -27,14 +27,14 @@ use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
-use super::{FrameInputs, Technique, clear_visibility};
+use super::{FrameInputs, Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::geometry::silhouette::{Caster, Mailbox};
 use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
-    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_indirect, draw_vertices, ensure, fullscreen,
-    shaders, transition,
+    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_indirect, draw_vertices, ensure, shaders,
+    transition,
 };
 
 /// t / (R / b) in the physical mode: what measured best against the reference (N = 256, 256²,
@@ -303,34 +303,19 @@ impl Technique for Smoothie {
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
-        frame.timer.begin(ctx, cmd, "resolve");
-        transition(
-            ctx,
-            cmd,
-            &mut [
-                (depth, Access::FRAGMENT_READ, false),
-                (alpha, Access::FRAGMENT_READ, false),
-                (falloff, Access::FRAGMENT_READ, false),
-                (visibility, Access::COLOR_WRITE, true),
-            ],
-        );
-        fullscreen(
-            ctx,
-            cmd,
-            &self.resolve,
-            visibility,
-            &[
-                Descriptor::Buffer(frame.globals),
-                Descriptor::Buffer(light),
-                Descriptor::Image(frame.depth),
-                Descriptor::Image(frame.normal),
-                Descriptor::Image(map),
-                Descriptor::Image(depth),
-                Descriptor::Image(alpha),
-                Descriptor::Image(falloff),
-            ],
-        );
-        frame.timer.end(ctx, cmd);
+        let readable = Access::FRAGMENT_READ;
+        transition(ctx, cmd, &mut [(depth, readable, false), (alpha, readable, false), (falloff, readable, false)]);
+        let inputs = [
+            Descriptor::Buffer(frame.globals),
+            Descriptor::Buffer(light),
+            Descriptor::Image(frame.depth),
+            Descriptor::Image(frame.normal),
+            Descriptor::Image(map),
+            Descriptor::Image(depth),
+            Descriptor::Image(alpha),
+            Descriptor::Image(falloff),
+        ];
+        resolve(frame, &self.resolve, visibility, &inputs);
         Ok(())
     }
 
