@@ -27,6 +27,7 @@ impl Binding {
 }
 
 /// A pass input, in binding order.
+#[derive(Clone, Copy)]
 pub enum Descriptor<'a> {
     Buffer(vk::DescriptorBufferInfo),
     Image(&'a Target),

@@ -73,6 +73,21 @@ pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Tec
     }
 }
 
+/// The first inputs of every resolve that reads the camera's surfaces, in binding order: the
+/// frame's globals, the technique's `light` (view) buffer, camera depth, camera normal.
+pub(crate) fn surface_inputs<'a>(
+    frame: &FrameInputs<'a>,
+    light: vk::DescriptorBufferInfo,
+) -> [crate::gpu::Descriptor<'a>; 4] {
+    use crate::gpu::Descriptor;
+    [
+        Descriptor::Buffer(frame.globals),
+        Descriptor::Buffer(light),
+        Descriptor::Image(frame.depth),
+        Descriptor::Image(frame.normal),
+    ]
+}
+
 /// The `resolve` pass every technique ends with: V overwritten by the full-screen `pipeline`
 /// reading `inputs` (already made readable).
 pub(crate) fn resolve(

@@ -29,7 +29,7 @@ use glam::{Mat4, Vec2, Vec4};
 
 use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility, resolve};
+use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::geometry::plateau::{
     PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides,
@@ -367,14 +367,9 @@ impl Technique for Plateau {
         }
 
         transition(ctx, cmd, &mut [(texture, Access::FRAGMENT_READ, false), (falloff, Access::FRAGMENT_READ, false)]);
-        let inputs = [
-            Descriptor::Buffer(frame.globals),
-            Descriptor::Buffer(view_range),
-            Descriptor::Image(frame.depth),
-            Descriptor::Image(frame.normal),
-            Descriptor::Image(texture),
-            Descriptor::Image(falloff),
-        ];
+        let inputs =
+            [&surface_inputs(frame, view_range)[..], &[Descriptor::Image(texture), Descriptor::Image(falloff)]]
+                .concat();
         resolve(frame, &self.resolve, visibility, &inputs);
         Ok(())
     }

@@ -14,7 +14,7 @@ use bytemuck::bytes_of;
 use glam::{Vec3, Vec4};
 
 use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility, resolve};
+use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
@@ -328,13 +328,7 @@ impl Technique for ShadowMap {
 
         let index = self.resolve(frame.ctx, filter)?;
         let (map, light) = self.pass.inputs(frame.slot);
-        let inputs = [
-            Descriptor::Buffer(frame.globals),
-            Descriptor::Buffer(light),
-            Descriptor::Image(frame.depth),
-            Descriptor::Image(frame.normal),
-            Descriptor::Image(map),
-        ];
+        let inputs = [&surface_inputs(frame, light)[..], &[Descriptor::Image(map)]].concat();
         resolve(frame, &self.resolves[index].1, visibility, &inputs);
         Ok(())
     }

@@ -27,7 +27,7 @@ use super::falloff::Falloff;
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
-use super::{FrameInputs, Technique, clear_visibility, resolve};
+use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::geometry::silhouette::{Caster, Mailbox};
 use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
@@ -306,15 +306,10 @@ impl Technique for Smoothie {
         let readable = Access::FRAGMENT_READ;
         transition(ctx, cmd, &mut [(depth, readable, false), (alpha, readable, false), (falloff, readable, false)]);
         let inputs = [
-            Descriptor::Buffer(frame.globals),
-            Descriptor::Buffer(light),
-            Descriptor::Image(frame.depth),
-            Descriptor::Image(frame.normal),
-            Descriptor::Image(map),
-            Descriptor::Image(depth),
-            Descriptor::Image(alpha),
-            Descriptor::Image(falloff),
-        ];
+            &surface_inputs(frame, light)[..],
+            &[Descriptor::Image(map), Descriptor::Image(depth), Descriptor::Image(alpha), Descriptor::Image(falloff)],
+        ]
+        .concat();
         resolve(frame, &self.resolve, visibility, &inputs);
         Ok(())
     }
