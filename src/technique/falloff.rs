@@ -7,8 +7,21 @@ use ash::vk;
 use bytemuck::cast_slice;
 use gpu_allocator::MemoryLocation;
 
+use super::knobs::Knob;
 use crate::error::Result;
 use crate::gpu::{Buffer, Context, Target, TargetDesc, copy_to_target};
+
+/// The knob choosing the curve. Linear is the default: it measured best against the reference
+/// for both plateaus and smoothies (the outer-only penumbrae start at the hard edge, where the
+/// true V is already ½, and the sine and smoothstep curves stay darker longer).
+pub const FALLOFF: Knob = Knob {
+    name: "falloff",
+    default: 0.0,
+    min: 0.0,
+    max: 2.0,
+    integer: true,
+    help: "gradient: 0 linear, 1 sine (Haines 3), 2 smoothstep (Parker)",
+};
 
 const FORMAT: vk::Format = vk::Format::R16_UNORM;
 const SIZE: u32 = 256;

@@ -27,7 +27,7 @@ use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec2, Vec4};
 
-use super::falloff::Falloff;
+use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
@@ -84,14 +84,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             integer: false,
             help: "size_mode 1: cone radius per unit of height (Haines used 0.1)",
         },
-        Knob {
-            name: "falloff",
-            default: 0.0,
-            min: 0.0,
-            max: 2.0,
-            integer: true,
-            help: "gradient: 0 linear, 1 sine (Haines 3), 2 smoothstep (Parker)",
-        },
+        FALLOFF,
         Knob {
             name: "edges",
             default: 0.0,

@@ -23,7 +23,7 @@ use ash::vk;
 use bytemuck::cast_slice;
 use glam::{Mat4, Vec3, Vec4};
 
-use super::falloff::Falloff;
+use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params, TechniqueInfo};
 use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
@@ -81,14 +81,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             integer: true,
             help: "1: the paper's 16-bit float shadow map; 0: 32-bit",
         },
-        Knob {
-            name: "falloff",
-            default: 0.0,
-            min: 0.0,
-            max: 2.0,
-            integer: true,
-            help: "gradient: 0 linear, 1 sine, 2 smoothstep",
-        },
+        FALLOFF,
         Knob {
             name: "gpu_silhouettes",
             default: 0.0,
