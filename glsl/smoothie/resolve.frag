@@ -19,17 +19,19 @@ layout(set = 0, binding = 7) uniform sampler2D falloff;
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// The smoothie test at the four texels around uv, bilinearly weighted: one gather each of
-// depth and alpha.
+// The smoothie test at the four texels around uv, bilinearly weighted: a gather of depth, and
+// of alpha where some texel's smoothie lies in front.
 float smoothie_test(vec2 uv, float depth) {
     float size = light.kernel.x;
     vec2 pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
     vec2 f = fract(pos);
     vec2 corner = (floor(pos) + 1.0) / size;
     // Gather order: (i0,j1) (i1,j1) (i1,j0) (i0,j0).
-    vec4 b = textureGather(smoothie_depth, corner, 0);
-    vec4 a = textureGather(smoothie_alpha, corner, 0);
-    vec4 v = mix(vec4(1.0), a, vec4(greaterThan(vec4(depth), b)));
+    vec4 behind = vec4(greaterThan(vec4(depth), textureGather(smoothie_depth, corner, 0)));
+    if (behind == vec4(0.0)) {
+        return 1.0; // behind no smoothie: most of the frame, spared the alpha fetch
+    }
+    vec4 v = mix(vec4(1.0), textureGather(smoothie_alpha, corner, 0), behind);
     return mix(mix(v.w, v.z, f.x), mix(v.x, v.y, f.x), f.y);
 }
 
