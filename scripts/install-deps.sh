@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # System packages for building and testing softshadow on Debian 12: the Vulkan loader, Mesa's
 # lavapipe (a CPU Vulkan driver), the Khronos validation layers, and the shader compiler
-# (libshaderc-dev with the glslang and SPIRV-Tools archives it links against).
+# (libshaderc-dev with the glslang and SPIRV-Tools archives it links against); DejaVu Sans for
+# the plots of `softshadow bench`.
 set -euo pipefail
 packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers
-          libshaderc-dev glslang-dev spirv-tools pkg-config)
+          libshaderc-dev glslang-dev spirv-tools pkg-config fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -119,3 +119,35 @@ fn compare_refuses_a_non_reference_ground_truth() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("parker"));
 }
+
+#[test]
+fn bench_quick_writes_results_a_report_and_a_plot() {
+    let out = std::env::temp_dir().join(format!("softshadow-bench-{}", std::process::id()));
+    let run = softshadow()
+        .args(["bench", "--quick", "--frames", "3", "--reference-samples", "16", "--techniques", "shadow-map,pcss"])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert!(header.contains(&"technique") && header.contains(&"gpu_ms_total_median"));
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 4, "two scenes x two techniques");
+    // Each scene has a Pareto-optimal row; PCSS, far more accurate, is always one.
+    let pareto = header.iter().position(|h| *h == "pareto").unwrap();
+    for scene in ["plate", "sphere"] {
+        let of: Vec<Vec<&str>> = rows.iter().filter(|r| r.starts_with(scene)).map(|r| r.split(',').collect()).collect();
+        assert!(of.iter().any(|r| r[1] == "pcss" && r[pareto] == "true"), "{scene}: {of:?}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## plate") && report.contains("llvmpipe") && report.contains("★"));
+    let plot = image::open(out.join("tradeoff.png")).unwrap();
+    assert!(plot.width() > 100 && plot.height() > 100);
+    // The references are cached, one per scene, for the next run.
+    let cached = std::fs::read_dir(out.join("cache")).unwrap().count();
+    assert_eq!(cached, 2);
+    std::fs::remove_dir_all(out).ok();
+}

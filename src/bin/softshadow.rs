@@ -26,6 +26,9 @@ enum Command {
     Render(RenderArgs),
     /// Render a technique and a reference, and print how wrong the technique is.
     Compare(CompareArgs),
+    /// The speed/accuracy sweep: every technique and setting on every scene, against the
+    /// reference; writes results.csv, report.md and tradeoff.png.
+    Bench(BenchArgs),
     /// List the techniques and their knobs with defaults.
     Techniques,
     /// Show the Vulkan device, driver and limits.
@@ -85,6 +88,27 @@ struct CompareArgs {
     diff: Option<PathBuf>,
 }
 
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scene files [default: every scene in scenes/].
+    scenes: Vec<PathBuf>,
+    /// Only these techniques (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    techniques: Vec<String>,
+    /// Output folder.
+    #[arg(long, default_value = "bench-out")]
+    out: PathBuf,
+    /// A small subset (two scenes, default settings, 128²) for CI.
+    #[arg(long)]
+    quick: bool,
+    /// Frames timed per setting, after warm-up.
+    #[arg(long, default_value_t = 20)]
+    frames: usize,
+    /// Light samples of the reference: its own error must stay far below the techniques'.
+    #[arg(long, default_value_t = 256)]
+    reference_samples: u32,
+}
+
 fn main() {
     if let Err(e) = run(Cli::parse()) {
         eprintln!("softshadow: {e:#}");
@@ -96,6 +120,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(args)) => render(&args).map(|_| ()),
         Some(Command::Compare(args)) => compare(&args),
+        Some(Command::Bench(args)) => bench(&args),
         Some(Command::Techniques) => {
             for t in TECHNIQUES {
                 println!("{}: {}", t.name, t.summary);
@@ -284,5 +309,97 @@ fn compare(args: &CompareArgs) -> Result<()> {
     for (name, value) in rows {
         println!("{name:<28} {value:>12}");
     }
+    Ok(())
+}
+
+/// `bench`: the sweep of measure::bench over the scene suite.
+fn bench(args: &BenchArgs) -> Result<()> {
+    use softshadow::measure::bench::{
+        BenchRow, load_reference, mark_pareto, save_reference, sweep, write_csv, write_report,
+    };
+    let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+    let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
+        args.scenes.clone()
+    } else if args.quick {
+        vec![suite.join("plate.toml"), suite.join("sphere.toml")]
+    } else {
+        let mut all: Vec<PathBuf> = std::fs::read_dir(&suite)
+            .with_context(|| format!("listing {}", suite.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        all.sort();
+        all
+    };
+    for t in &args.techniques {
+        knobs::find(t)?;
+    }
+    let runs: Vec<_> = sweep(args.quick)
+        .into_iter()
+        .filter(|(t, _)| args.techniques.is_empty() || args.techniques.iter().any(|n| n == t))
+        .collect();
+    let size = if args.quick { 128 } else { 512 };
+    let cache = args.out.join("cache");
+    std::fs::create_dir_all(&cache).with_context(|| format!("creating {}", cache.display()))?;
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let bar = indicatif::ProgressBar::new((scenes.len() * (runs.len() + 1)) as u64);
+    let mut rows = Vec::new();
+    for path in &scenes {
+        let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
+        let what = SceneArgs {
+            scene: path.clone(),
+            technique: Some("reference".into()),
+            set: vec![format!("samples={}", args.reference_samples)],
+            width: Some(size),
+            height: Some(size),
+            frames: None,
+        };
+        let (scene, truth_settings) = load(&what)?;
+        // Reference images are cached by a hash of the scene file and the reference's settings.
+        let text = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (text, size, truth_settings.params.to_string(), env!("CARGO_PKG_VERSION")).hash(&mut h);
+            h.finish()
+        };
+        let cached = cache.join(format!("{name}-{key:016x}.ref"));
+        bar.set_message(format!("{name}: reference"));
+        let truth = match load_reference(&cached, size, size) {
+            Some(c) => c,
+            None => {
+                let (c, _) = render_frames(&mut engine, &scene, &truth_settings, None)?;
+                save_reference(&c, &cached)?;
+                c
+            }
+        };
+        bar.inc(1);
+        for (technique, sets) in &runs {
+            bar.set_message(format!("{name}: {technique}"));
+            let mut settings =
+                FrameSettings { params: Params::defaults(knobs::find(technique)?), ..truth_settings.clone() };
+            settings.params.apply(sets.iter().copied())?;
+            let (capture, timings) = render_frames(&mut engine, &scene, &settings, Some(args.frames))?;
+            let metrics = Metrics::between(&capture, &truth)?;
+            let setting = sets.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+            rows.push(BenchRow {
+                scene: name.clone(),
+                technique: technique.to_string(),
+                setting,
+                timings,
+                metrics,
+                pareto: false,
+            });
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    finish(engine)?;
+    mark_pareto(&mut rows);
+    let reference = format!("reference (samples={})", args.reference_samples);
+    write_csv(&rows, &args.out.join("results.csv"))?;
+    write_report(&rows, &reference, &args.out.join("report.md"))?;
+    softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
+    println!("wrote {0}/results.csv, {0}/report.md, {0}/tradeoff.png", args.out.display());
     Ok(())
 }

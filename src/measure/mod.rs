@@ -1,7 +1,11 @@
-//! Measurement: GPU timing reports and error metrics against the reference.
+//! Measurement: GPU timing reports, error metrics against the reference, the speed/accuracy
+//! sweep and its plot.
 
+pub mod bench;
 mod metrics;
+mod plot;
 mod timings;
 
 pub use metrics::{GROSS_ERROR, Metrics, PENUMBRA, save_difference};
+pub use plot::tradeoff;
 pub use timings::{PassSummary, TimingReport};

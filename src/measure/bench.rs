@@ -1,0 +1,187 @@
+//! The speed/accuracy sweep behind `softshadow bench`: what each setting of each technique
+//! costs (GPU ms per pass, CPU ms per frame) and how wrong it is against the reference, per
+//! scene, with the Pareto-optimal rows marked; written as CSV and a Markdown report.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::measure::{Metrics, TimingReport};
+use crate::renderer::{Capture, Surfaces};
+
+/// One scene × technique × setting.
+#[derive(Clone, Debug)]
+pub struct BenchRow {
+    pub scene: String,
+    pub technique: String,
+    /// The knobs set, `key=value` separated by spaces; empty for the defaults.
+    pub setting: String,
+    pub timings: TimingReport,
+    pub metrics: Metrics,
+    /// No other row of the scene is both cheaper and more accurate (penumbra RMSE).
+    pub pareto: bool,
+}
+
+/// The settings swept per technique: the knobs that trade speed for accuracy.
+pub fn sweep(quick: bool) -> Vec<(&'static str, Vec<(&'static str, &'static str)>)> {
+    let mut runs = vec![
+        ("shadow-map", vec![]),
+        ("pcf", vec![("taps", "16")]),
+        ("pcss", vec![]),
+        ("plateau", vec![]),
+        ("smoothie", vec![]),
+    ];
+    if !quick {
+        runs.extend([
+            ("shadow-map", vec![("shadow_map_size", "1024")]),
+            ("pcf", vec![("taps", "4")]),
+            ("pcf", vec![("taps", "32")]),
+            ("pcf", vec![("bicubic", "1")]),
+            ("pcss", vec![("blocker_samples", "32"), ("filter_samples", "32")]),
+            ("plateau", vec![("falloff", "1")]),
+            ("plateau", vec![("texture_size", "512")]),
+            ("smoothie", vec![("t_scale", "1")]),
+            ("smoothie", vec![("depth16", "1")]),
+            ("smoothie", vec![("gpu_silhouettes", "1")]),
+        ]);
+    }
+    runs
+}
+
+/// Marks the rows no other row of the same scene dominates (cheaper and no less accurate, or
+/// more accurate and no dearer).
+pub fn mark_pareto(rows: &mut [BenchRow]) {
+    let keys: Vec<(String, f64, f64)> =
+        rows.iter().map(|r| (r.scene.clone(), r.timings.gpu_ms_total_median, r.metrics.penumbra_rmse)).collect();
+    for (i, row) in rows.iter_mut().enumerate() {
+        let (scene, ms, err) = &keys[i];
+        row.pareto = !keys
+            .iter()
+            .enumerate()
+            .any(|(j, (s, m, e))| j != i && s == scene && m <= ms && e <= err && (m < ms || e < err));
+    }
+}
+
+pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
+    let mut out = String::from(
+        "scene,technique,setting,gpu_ms_total_median,gpu_ms_total_p95,cpu_ms_median,rmse,mae,max_abs,p99_abs,\
+         penumbra_rmse,leak_rate,dark_rate,mean_bias,pixels,excluded,pareto,passes\n",
+    );
+    for r in rows {
+        let m = &r.metrics;
+        let passes: Vec<String> =
+            r.timings.passes.iter().map(|p| format!("{}={:.3}", p.name, p.gpu_ms_median)).collect();
+        let _ = writeln!(
+            out,
+            "{},{},\"{}\",{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{},{},\"{}\"",
+            r.scene,
+            r.technique,
+            r.setting,
+            r.timings.gpu_ms_total_median,
+            r.timings.gpu_ms_total_p95,
+            r.timings.cpu_ms.get("record").copied().unwrap_or(0.0),
+            m.rmse,
+            m.mae,
+            m.max_abs,
+            m.p99_abs,
+            m.penumbra_rmse,
+            m.leak_rate,
+            m.dark_rate,
+            m.mean_bias,
+            m.pixels,
+            m.excluded,
+            r.pareto,
+            passes.join(" ")
+        );
+    }
+    std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+}
+
+/// Per scene, a table sorted by cost with the Pareto-optimal rows marked.
+pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<()> {
+    let mut out = String::from("# softshadow bench\n\n");
+    if let Some(r) = rows.first() {
+        let t = &r.timings;
+        let _ = writeln!(
+            out,
+            "{}, {}; {}x{}, GPU ms: median (p95) over {} frames after warm-up. Error against {reference}. \
+             ★ marks the Pareto-optimal rows (no other row both cheaper and more accurate in the penumbra).\n",
+            t.device, t.driver, t.width, t.height, t.frames
+        );
+    }
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for scene in scenes {
+        let mut of_scene: Vec<&BenchRow> = rows.iter().filter(|r| r.scene == scene).collect();
+        of_scene.sort_by(|a, b| a.timings.gpu_ms_total_median.total_cmp(&b.timings.gpu_ms_total_median));
+        let _ = writeln!(out, "## {scene}\n");
+        out += "| | technique | setting | GPU ms | CPU ms | RMSE | penumbra RMSE | leak | dark |\n";
+        out += "|---|---|---|---|---|---|---|---|---|\n";
+        for r in of_scene {
+            let (t, m) = (&r.timings, &r.metrics);
+            let _ = writeln!(
+                out,
+                "| {} | {} | {} | {:.2} ({:.2}) | {:.3} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                if r.pareto { "★" } else { "" },
+                r.technique,
+                if r.setting.is_empty() { "defaults" } else { &r.setting },
+                t.gpu_ms_total_median,
+                t.gpu_ms_total_p95,
+                t.cpu_ms.get("record").copied().unwrap_or(0.0),
+                m.rmse,
+                m.penumbra_rmse,
+                m.leak_rate,
+                m.dark_rate
+            );
+        }
+        out += "\n";
+    }
+    std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+}
+
+/// Stores a reference capture's visibility and surfaces (the colour is not needed).
+pub fn save_reference(capture: &Capture, path: &Path) -> Result<()> {
+    let s = &capture.surfaces;
+    let mut bytes = Vec::new();
+    bytes.extend(capture.width.to_le_bytes());
+    bytes.extend(capture.height.to_le_bytes());
+    for i in 0..capture.visibility.len() {
+        bytes.extend(capture.visibility[i].to_le_bytes());
+        bytes.extend(s.depth[i].to_le_bytes());
+        for c in s.normal[i].to_array() {
+            bytes.extend(c.to_le_bytes());
+        }
+        bytes.push(u8::from(s.receives[i]));
+    }
+    std::fs::write(path, bytes).map_err(|source| Error::Io { path: path.into(), source })
+}
+
+/// A capture stored by [`save_reference`], if `path` holds one of `width` × `height`.
+pub fn load_reference(path: &Path, width: u32, height: u32) -> Option<Capture> {
+    let bytes = std::fs::read(path).ok()?;
+    const PIXEL: usize = 2 + 4 + 12 + 1;
+    let n = width as usize * height as usize;
+    let header = [width.to_le_bytes(), height.to_le_bytes()].concat();
+    if bytes.len() != 8 + n * PIXEL || bytes[..8] != header[..] {
+        return None;
+    }
+    let f32_at = |b: &[u8]| f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    let mut capture = Capture {
+        width,
+        height,
+        color: vec![0; n * 4],
+        visibility: Vec::with_capacity(n),
+        surfaces: Surfaces {
+            depth: Vec::with_capacity(n),
+            normal: Vec::with_capacity(n),
+            receives: Vec::with_capacity(n),
+        },
+    };
+    for p in bytes[8..].chunks_exact(PIXEL) {
+        capture.visibility.push(u16::from_le_bytes([p[0], p[1]]));
+        capture.surfaces.depth.push(f32_at(&p[2..]));
+        capture.surfaces.normal.push(glam::Vec3::new(f32_at(&p[6..]), f32_at(&p[10..]), f32_at(&p[14..])));
+        capture.surfaces.receives.push(p[18] != 0);
+    }
+    Some(capture)
+}

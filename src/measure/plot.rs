@@ -1,0 +1,95 @@
+//! `tradeoff.png`: penumbra RMSE against GPU ms, a series per technique, the Pareto frontier
+//! drawn. Text uses Debian's DejaVu Sans through ab_glyph (no system font lookup).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+
+use super::bench::BenchRow;
+use crate::error::{Error, Result};
+
+/// Where Debian's fonts-dejavu-core puts the font (scripts/install-deps.sh installs it).
+const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+
+const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Invalid(format!("plotting {}: {e}", path.display()))
+}
+
+/// Draws every row, a colour per technique, and each scene's Pareto frontier as a line.
+pub fn tradeoff(rows: &[BenchRow], path: &Path) -> Result<()> {
+    let font = std::fs::read(FONT).map_err(|source| Error::Io { path: FONT.into(), source })?;
+    // plotters keeps registered fonts for the process's life.
+    register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
+        .map_err(|_| plot_error(path, "cannot read DejaVu Sans"))?;
+    let max_ms = rows.iter().map(|r| r.timings.gpu_ms_total_median).fold(1.0, f64::max) * 1.1;
+    let max_err = rows.iter().map(|r| r.metrics.penumbra_rmse).fold(0.05, f64::max) * 1.1;
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("speed / accuracy: penumbra RMSE against GPU ms per frame", ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..max_ms, 0.0..max_err)
+        .map_err(|e| plot_error(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc("GPU ms (median)")
+        .y_desc("penumbra RMSE")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| plot_error(path, e))?;
+    let mut techniques: Vec<&str> = rows.iter().map(|r| r.technique.as_str()).collect();
+    techniques.sort();
+    techniques.dedup();
+    for (i, technique) in techniques.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        let points: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.technique == *technique)
+            .map(|r| (r.timings.gpu_ms_total_median, r.metrics.penumbra_rmse))
+            .collect();
+        chart
+            .draw_series(points.iter().map(|p| Circle::new(*p, 5, color.filled())))
+            .map_err(|e| plot_error(path, e))?
+            .label(*technique)
+            .legend(move |(x, y)| Circle::new((x, y), 5, color.filled()));
+    }
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    for (i, scene) in scenes.iter().enumerate() {
+        let mut frontier: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.pareto && r.scene == *scene)
+            .map(|r| (r.timings.gpu_ms_total_median, r.metrics.penumbra_rmse))
+            .collect();
+        frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let series =
+            chart.draw_series(LineSeries::new(frontier, BLACK.stroke_width(2))).map_err(|e| plot_error(path, e))?;
+        if i == 0 {
+            series
+                .label("Pareto frontier (per scene)")
+                .legend(|(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], BLACK.stroke_width(2)));
+        }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(|e| plot_error(path, e))?;
+    root.present().map_err(|e| plot_error(path, e))
+}
