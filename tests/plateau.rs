@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{engine, finish, render_with, scene};
+use common::{engine, finish, render_with, scene, top_down};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -151,24 +151,8 @@ fn low_lights_stretch_the_shadow_without_breaking() {
 fn a_caster_reaching_above_the_light_casts_no_anti_shadow() {
     // A tall post whose top is above the light: the part above casts nothing (clipped at w = 0),
     // so the ground between the post and the light stays lit.
-    let s = scene(
-        r#"
-[camera]
-position = [0.0, 12.0, 0.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]
-ortho_half_height = 4.0
-[light]
-position = [2.0, 2.0, 0.0]
-radius = 0.1
-[ground]
-height = 0.0
-[[object]]
-shape = "box"
-size = [0.3, 6.0, 0.3]
-position = [0.0, 3.0, 0.0]
-"#,
-    );
+    let post = "[[object]]\nshape = \"box\"\nsize = [0.3, 6.0, 0.3]\nposition = [0.0, 3.0, 0.0]\n";
+    let s = top_down(0.0, 4.0, [2.0, 2.0, 0.0], 0.1, post);
     let mut e = engine();
     let c = render_with(&mut e, &s, "plateau", &[], 64);
     // Between the post (x = 0) and the light's foot (x = 2): lit. Behind the post: shadow.
@@ -184,26 +168,12 @@ fn nested_and_equal_cone_radii_stay_sane() {
     // A vertical pole under a light straight above: its foot's cone (radius 0) lies inside its
     // top's cone, so those sides have no outer tangent. A plate parallel to the ground: all radii
     // equal, every sheet a flat quad.
-    let pole = scene(
-        r#"
-[camera]
-position = [0.0, 12.0, 0.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]
-ortho_half_height = 2.0
-[light]
-position = [0.0, 8.0, 0.0]
-radius = 0.5
-[ground]
-height = 0.0
-[[object]]
-shape = "cylinder"
-radius = 0.05
-height = 3.0
-position = [0.0, 1.5, 0.0]
-casts = true
-receives = false
-"#,
+    let pole = top_down(
+        0.0,
+        2.0,
+        [0.0, 8.0, 0.0],
+        0.5,
+        "[[object]]\nshape = \"cylinder\"\nradius = 0.05\nheight = 3.0\nposition = [0.0, 1.5, 0.0]\nreceives = false\n",
     );
     let mut e = engine();
     let c = render_with(&mut e, &pole, "plateau", &[], 64);
@@ -241,18 +211,7 @@ fn open_meshes_and_off_plane_receivers() {
     // An open box (no bottom): boundary edges switch the plateau to every light-facing polygon.
     // Under it, a receiver that casts nothing, off the plane: unshadowed by default, shadowed by
     // the projected light map with off_plane = 1.
-    let s = scene(
-        r#"
-[camera]
-position = [0.0, 12.0, 0.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]
-ortho_half_height = 3.0
-[light]
-position = [0.0, 9.0, 0.0]
-radius = 0.3
-[ground]
-height = 0.0
+    let objects = r#"
 [[object]]
 shape = "mesh"
 mesh = "../models/cube_no_bottom.obj"
@@ -268,8 +227,8 @@ shape = "box"
 size = [2.0, 0.2, 2.0]
 position = [1.5, 0.4, 0.0]
 casts = false
-"#,
-    );
+"#;
+    let s = top_down(0.0, 3.0, [0.0, 9.0, 0.0], 0.3, objects);
     let mut e = engine();
     let plain = render_with(&mut e, &s, "plateau", &[], 64);
     // The open box's shadow on the ground, where the box does not hide it (x = −2.8).

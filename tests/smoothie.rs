@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{engine, finish, render_with, scene};
+use common::{engine, finish, render_with};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -20,11 +20,7 @@ fn top_down(light_radius: f32, objects: &str) -> Scene {
 
 /// [`top_down`] with the light at x = `light_x`, 10 m up.
 fn lit_from(light_x: f32, light_radius: f32, objects: &str) -> Scene {
-    scene(&format!(
-        "[camera]\nposition = [0.0, 20.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
-         ortho_half_height = 3.0\n[light]\nposition = [{light_x}, 10.0, 0.0]\nradius = {light_radius}\n\
-         [ground]\nheight = 0.0\n{objects}"
-    ))
+    common::top_down(0.0, 3.0, [light_x, 10.0, 0.0], light_radius, objects)
 }
 
 fn pixel(x: f32) -> u32 {

@@ -22,6 +22,18 @@ pub fn scene(text: &str) -> Scene {
     Scene::from_toml(text, "tests/inline.toml").expect("valid test scene")
 }
 
+/// The ground seen from straight above by an orthographic camera at (`x`, 12, 0) (image x =
+/// world x, rows = world z, `half` metres each way), a light at `light` of `radius`, and
+/// `objects` (their TOML).
+pub fn top_down(x: f32, half: f32, light: [f32; 3], radius: f32, objects: &str) -> Scene {
+    scene(&format!(
+        "[camera]\nposition = [{x}, 12.0, 0.0]\ntarget = [{x}, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+         ortho_half_height = {half}\n[light]\nposition = [{}, {}, {}]\nradius = {radius}\n\
+         [ground]\nheight = 0.0\n{objects}",
+        light[0], light[1], light[2]
+    ))
+}
+
 /// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
 pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
     let mut frame = settings(s, size, size);
