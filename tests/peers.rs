@@ -4,10 +4,9 @@
 
 mod common;
 
-use common::{engine, finish, render_with, scene};
+use common::{engine, finish, reference, render_with, scene, suite_scene};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
-use softshadow::scene::Scene;
 
 /// A thin wall standing on the ground at x = 0 under a light at +x, seen from straight above
 /// (image x = world x, image rows = world z, 3 m across): its shadow runs to −x, and the penumbra
@@ -114,15 +113,10 @@ const BOUNDS: [(&str, &str, f64); 6] = [
 
 #[test]
 fn pcf_and_pcss_stay_within_their_bounds_of_the_reference() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
-    let scenes = [
-        ("plate", Scene::load(format!("{dir}plate.toml")).unwrap()),
-        ("sphere", Scene::load(format!("{dir}sphere.toml")).unwrap()),
-        ("wall", scene(WALL)),
-    ];
+    let scenes = [("plate", suite_scene("plate")), ("sphere", suite_scene("sphere")), ("wall", scene(WALL))];
     let mut e = engine();
     for (name, s) in &scenes {
-        let truth = render_with(&mut e, s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
+        let truth = reference(&mut e, s, 64);
         let mut rmse = Vec::new();
         for (_, technique, bound) in BOUNDS.iter().filter(|(n, ..)| n == name) {
             let m = Metrics::between(&render_with(&mut e, s, technique, &[], 64), &truth).unwrap();

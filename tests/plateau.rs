@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{engine, finish, render_with, scene, top_down};
+use common::{engine, finish, reference, render_with, scene, suite_scene, top_down};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -178,7 +178,7 @@ fn nested_and_equal_cone_radii_stay_sane() {
     let mut e = engine();
     let c = render_with(&mut e, &pole, "plateau", &[], 64);
     assert!(c.visibility_at(4, 4) > 0.99, "far from the pole: lit");
-    let plate = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/plate.toml")).unwrap();
+    let plate = suite_scene("plate");
     let p = render_with(&mut e, &plate, "plateau", &[], 64);
     assert!(p.visibility.contains(&0) && p.visibility.iter().any(|&v| v > 0 && v < 65535));
     finish(e);
@@ -192,11 +192,10 @@ const BOUNDS: [(&str, f64); 2] = [("plate", 0.06), ("sphere", 0.055)];
 
 #[test]
 fn the_error_against_the_reference_stays_under_its_bounds() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
     let mut e = engine();
     for (name, bound) in BOUNDS {
-        let s = Scene::load(format!("{dir}{name}.toml")).unwrap();
-        let truth = render_with(&mut e, &s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
+        let s = suite_scene(name);
+        let truth = reference(&mut e, &s, 64);
         let plateau = Metrics::between(&render_with(&mut e, &s, "plateau", &[], 64), &truth).unwrap();
         let hard = Metrics::between(&render_with(&mut e, &s, "shadow-map", &[], 64), &truth).unwrap();
         eprintln!("{name}: plateau RMSE {:.4} (hard {:.4})", plateau.rmse, hard.rmse);

@@ -6,7 +6,7 @@ mod common;
 
 use std::f64::consts::PI;
 
-use common::{engine, finish, render_with, scene};
+use common::{engine, finish, render_with, scene, suite_scene};
 use glam::Vec3;
 use softshadow::measure::Metrics;
 use softshadow::reference::{Surface, TraceScene};
@@ -151,8 +151,7 @@ fn parker_is_never_lighter_than_the_light_allows() {
 }
 
 fn test_scenes() -> [Scene; 2] {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
-    [Scene::load(format!("{dir}plate.toml")).unwrap(), Scene::load(format!("{dir}sphere.toml")).unwrap()]
+    [suite_scene("plate"), suite_scene("sphere")]
 }
 
 /// Fewer texels than the default keep the 1024-sample runs short on lavapipe.

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{engine, finish, render_with};
+use common::{engine, finish, reference, render_with, suite_scene};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -137,9 +137,8 @@ impl FarLight for Scene {
 
 #[test]
 fn a_point_light_gives_exactly_the_hard_shadow_and_16_bit_depth_costs_little() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
     let mut e = engine();
-    let mut plate = Scene::load(format!("{dir}plate.toml")).unwrap();
+    let mut plate = suite_scene("plate");
     let full = render_with(&mut e, &plate, "smoothie", &[], 64);
     let half = render_with(&mut e, &plate, "smoothie", &[("depth16", "1")], 64);
     let m = Metrics::between(&half, &full).unwrap();
@@ -158,11 +157,10 @@ const BOUNDS: [(&str, f64); 2] = [("plate", 0.06), ("sphere", 0.065)];
 
 #[test]
 fn the_error_against_the_reference_stays_under_its_bounds() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
     let mut e = engine();
     for (name, bound) in BOUNDS {
-        let s = Scene::load(format!("{dir}{name}.toml")).unwrap();
-        let truth = render_with(&mut e, &s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
+        let s = suite_scene(name);
+        let truth = reference(&mut e, &s, 64);
         let m = Metrics::between(&render_with(&mut e, &s, "smoothie", &[], 64), &truth).unwrap();
         eprintln!("{name}: smoothie RMSE {:.4}, penumbra RMSE {:.4}", m.rmse, m.penumbra_rmse);
         assert!(m.rmse < bound, "{name}: RMSE {} over {bound}", m.rmse);
@@ -172,12 +170,11 @@ fn the_error_against_the_reference_stays_under_its_bounds() {
 
 #[test]
 fn the_compute_path_draws_the_same_smoothies_as_the_cpu() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/");
     let mut e = engine();
     // The default scene (meshes and primitives, several casters) and the plate (a closed
     // zero-thickness mesh).
     for name in ["default", "plate"] {
-        let s = Scene::load(format!("{dir}{name}.toml")).unwrap();
+        let s = suite_scene(name);
         let cpu = render_with(&mut e, &s, "smoothie", &[], 96);
         for _ in 0..3 {
             // Several frames: the mailbox stamps must not carry over.

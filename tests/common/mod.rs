@@ -34,6 +34,17 @@ pub fn top_down(x: f32, half: f32, light: [f32; 3], radius: f32, objects: &str) 
     ))
 }
 
+/// A scene of the suite in scenes/, by name.
+pub fn suite_scene(name: &str) -> Scene {
+    Scene::load(format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))).expect("a scene of the suite")
+}
+
+/// The ground truth the accuracy bounds are stated against: the GPU reference with 256 light
+/// samples (512² maps, which keeps lavapipe quick).
+pub fn reference(e: &mut Engine, s: &Scene, size: u32) -> Capture {
+    render_with(e, s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], size)
+}
+
 /// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
 pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
     let mut frame = settings(s, size, size);
