@@ -6,9 +6,10 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 use softshadow::geometry::silhouette::{Caster, Mailbox};
 use softshadow::geometry::smoothie::{SmoothieSize, silhouette, smoothies};
+use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
 
 fn smoothie(c: &mut Criterion) {
@@ -20,17 +21,12 @@ fn smoothie(c: &mut Criterion) {
     group.throughput(Throughput::Elements(wingnut.adjacency.edges.len() as u64));
     group.bench_function("silhouette edges", |b| b.iter(|| silhouette(black_box(&caster), light)));
     let edges = silhouette(&caster, light);
-    // A light view looking from the light at the model.
-    let forward = (Vec3::Y - light).normalize();
-    let right = Vec3::Y.cross(forward).normalize();
-    let up = forward.cross(right);
-    let view = Mat4::from_cols(
-        Vec4::new(right.x, up.x, forward.x, 0.0),
-        Vec4::new(right.y, up.y, forward.y, 0.0),
-        Vec4::new(right.z, up.z, forward.z, 0.0),
-        Vec4::new(-right.dot(light), -up.dot(light), -forward.dot(light), 1.0),
-    );
-    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, 20.0);
+    // The light view a frame would fit: around the model, cut to a ground square under it.
+    let bounds = Aabb::from_points(positions.iter().copied());
+    let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
+    let frustum = fit_spot_frustum(light, bounds.center(), &bounds.corners(), &ground).expect("the model is in view");
+    let view = frustum.view;
+    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, frustum.far);
     let mut mailbox = Mailbox::default();
     let mut frame = 0;
     group.bench_function("smoothie geometry", |b| {

@@ -4,45 +4,15 @@
 
 mod common;
 
-use common::{engine, finish, reference, render_with, scene, suite_scene};
-use softshadow::Capture;
+use common::{
+    WALL_SIZE as SIZE, against_reference, engine, finish, render_with, suite_scene, wall, wall_column as column,
+    wall_edge_width as edge_width,
+};
 use softshadow::measure::Metrics;
-
-/// A thin wall standing on the ground at x = 0 under a light at +x, seen from straight above
-/// (image x = world x, image rows = world z, 3 m across): its shadow runs to −x, and the penumbra
-/// of its side edges widens with the distance from the wall's foot, where it touches the ground.
-const WALL: &str = r#"
-[camera]
-position = [-1.0, 10.0, 0.0]
-target = [-1.0, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]
-ortho_half_height = 1.5
-[light]
-position = [3.0, 3.0, 0.0]
-radius = 0.25
-[ground]
-height = 0.0
-[[object]]
-shape = "box"
-size = [0.1, 2.0, 1.0]
-position = [0.0, 1.0, 0.0]
-"#;
-
-const SIZE: u32 = 128;
-
-/// Pixel column of world x in the wall view.
-fn column(x: f32) -> u32 {
-    ((x + 2.5) / 3.0 * SIZE as f32) as u32
-}
-
-/// Penumbra pixels (0.02 < V < 0.98) down column `x` across the wall shadow's +z side edge.
-fn edge_width(c: &Capture, x: u32) -> usize {
-    (SIZE / 2..SIZE).filter(|&y| (0.02..0.98).contains(&c.visibility_at(x, y))).count()
-}
 
 #[test]
 fn pcss_hardens_at_contact_and_widens_with_distance_while_pcf_keeps_its_width() {
-    let s = scene(WALL);
+    let s = wall(1.0, 0.25);
     let mut e = engine();
     let pcss = render_with(&mut e, &s, "pcss", &[], SIZE);
     let (near, far) = (edge_width(&pcss, column(-0.15)), edge_width(&pcss, column(-1.8)));
@@ -62,7 +32,7 @@ fn pcss_hardens_at_contact_and_widens_with_distance_while_pcf_keeps_its_width() 
 
 #[test]
 fn extreme_settings_stay_sane() {
-    let s = scene(WALL);
+    let s = wall(1.0, 0.25);
     let mut e = engine();
     let umbra = (column(-1.0), SIZE / 2);
     let lit = (column(0.3), SIZE / 8);
@@ -89,7 +59,7 @@ fn extreme_settings_stay_sane() {
 
 #[test]
 fn a_point_light_makes_pcss_the_hard_shadow() {
-    let mut s = scene(WALL);
+    let mut s = wall(1.0, 0.25);
     s.light.radius = 0.0;
     let mut e = engine();
     let hard = render_with(&mut e, &s, "shadow-map", &[], 64);
@@ -113,15 +83,14 @@ const BOUNDS: [(&str, &str, f64); 6] = [
 
 #[test]
 fn pcf_and_pcss_stay_within_their_bounds_of_the_reference() {
-    let scenes = [("plate", suite_scene("plate")), ("sphere", suite_scene("sphere")), ("wall", scene(WALL))];
+    let scenes = [("plate", suite_scene("plate")), ("sphere", suite_scene("sphere")), ("wall", wall(1.0, 0.25))];
     let mut e = engine();
     for (name, s) in &scenes {
-        let truth = reference(&mut e, s, 64);
-        let mut rmse = Vec::new();
-        for (_, technique, bound) in BOUNDS.iter().filter(|(n, ..)| n == name) {
-            let m = Metrics::between(&render_with(&mut e, s, technique, &[], 64), &truth).unwrap();
-            assert!(m.rmse < *bound, "{name} {technique}: RMSE {} over {bound}", m.rmse);
-            rmse.push(m.rmse);
+        let of_scene: Vec<_> = BOUNDS.iter().filter(|(n, ..)| n == name).collect();
+        let techniques: Vec<&str> = of_scene.iter().map(|(_, t, _)| *t).collect();
+        let rmse: Vec<f64> = against_reference(&mut e, s, &techniques).iter().map(|m| m.rmse).collect();
+        for ((_, technique, bound), rmse) in of_scene.iter().zip(&rmse) {
+            assert!(rmse < bound, "{name} {technique}: RMSE {rmse} over {bound}");
         }
         assert!(rmse[1] < rmse[0], "{name}: PCSS (RMSE {}) should beat PCF ({})", rmse[1], rmse[0]);
     }

@@ -5,55 +5,13 @@
 
 mod common;
 
-use common::{engine, finish, reference, render_with, scene, suite_scene, top_down};
+use common::{
+    WALL_SIZE as SIZE, against_reference, engine, finish, render_with, scene, suite_scene, top_down, wall,
+    wall_column as column, wall_edge_width as edge_width,
+};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
-
-const SIZE: u32 = 128;
-
-/// A thin wall on the ground at x = 0 under a light at +x, seen from straight above (image x =
-/// world x, rows = world z, 3 m across), everything scaled by `s`.
-fn wall(s: f32, light_radius: f32) -> Scene {
-    scene(&format!(
-        r#"
-[camera]
-position = [{cx}, {ch}, 0.0]
-target = [{cx}, 0.0, 0.0]
-up = [0.0, 0.0, -1.0]
-ortho_half_height = {half}
-[light]
-position = [{l}, {l}, 0.0]
-radius = {r}
-[ground]
-height = 0.0
-half_size = {g}
-[[object]]
-shape = "box"
-size = [{t}, {two}, {one}]
-position = [0.0, {one}, 0.0]
-"#,
-        cx = -s,
-        ch = 10.0 * s,
-        half = 1.5 * s,
-        l = 3.0 * s,
-        r = light_radius * s,
-        g = 10.0 * s,
-        t = 0.1 * s,
-        two = 2.0 * s,
-        one = s,
-    ))
-}
-
-/// Pixel column of world x / scale in the wall view.
-fn column(x: f32) -> u32 {
-    ((x + 2.5) / 3.0 * SIZE as f32) as u32
-}
-
-/// Penumbra pixels (0.02 < V < 0.98) down column `x` across the shadow's +z side edge.
-fn edge_width(c: &Capture, x: u32) -> usize {
-    (SIZE / 2..SIZE).filter(|&y| (0.02..0.98).contains(&c.visibility_at(x, y))).count()
-}
 
 #[test]
 fn the_penumbra_widens_with_height_vanishes_at_contact_and_keeps_a_dark_umbra() {
@@ -194,10 +152,9 @@ const BOUNDS: [(&str, f64); 2] = [("plate", 0.06), ("sphere", 0.055)];
 fn the_error_against_the_reference_stays_under_its_bounds() {
     let mut e = engine();
     for (name, bound) in BOUNDS {
-        let s = suite_scene(name);
-        let truth = reference(&mut e, &s, 64);
-        let plateau = Metrics::between(&render_with(&mut e, &s, "plateau", &[], 64), &truth).unwrap();
-        let hard = Metrics::between(&render_with(&mut e, &s, "shadow-map", &[], 64), &truth).unwrap();
+        let [plateau, hard] =
+            <[_; 2]>::try_from(against_reference(&mut e, &suite_scene(name), &["plateau", "shadow-map"]))
+                .expect("two techniques");
         eprintln!("{name}: plateau RMSE {:.4} (hard {:.4})", plateau.rmse, hard.rmse);
         assert!(plateau.rmse < bound, "{name}: plateau RMSE {} over {bound}", plateau.rmse);
         assert!(plateau.rmse < hard.rmse, "{name}: the plateau should beat the hard shadow");

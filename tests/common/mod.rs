@@ -45,6 +45,51 @@ pub fn reference(e: &mut Engine, s: &Scene, size: u32) -> Capture {
     render_with(e, s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], size)
 }
 
+/// Each technique's error against [`reference`] on `s` at 64², in order (one reference render).
+pub fn against_reference(e: &mut Engine, s: &Scene, techniques: &[&str]) -> Vec<softshadow::measure::Metrics> {
+    let truth = reference(e, s, 64);
+    techniques
+        .iter()
+        .map(|t| softshadow::measure::Metrics::between(&render_with(e, s, t, &[], 64), &truth).expect("same size"))
+        .collect()
+}
+
+/// Image size of the [`wall`] views.
+pub const WALL_SIZE: u32 = 128;
+
+/// A thin wall on the ground at x = 0 under a light at +x, seen from straight above (image x =
+/// world x, rows = world z, 3 m across), everything scaled by `s`: its shadow runs to −x, and
+/// the penumbra of its side edges widens with the distance from its foot, where it touches the
+/// ground.
+pub fn wall(s: f32, light_radius: f32) -> Scene {
+    scene(&format!(
+        "[camera]\nposition = [{cx}, {ch}, 0.0]\ntarget = [{cx}, 0.0, 0.0]\nup = [0.0, 0.0, -1.0]\n\
+         ortho_half_height = {half}\n[light]\nposition = [{l}, {l}, 0.0]\nradius = {r}\n\
+         [ground]\nheight = 0.0\nhalf_size = {g}\n\
+         [[object]]\nshape = \"box\"\nsize = [{t}, {two}, {one}]\nposition = [0.0, {one}, 0.0]\n",
+        cx = -s,
+        ch = 10.0 * s,
+        half = 1.5 * s,
+        l = 3.0 * s,
+        r = light_radius * s,
+        g = 10.0 * s,
+        t = 0.1 * s,
+        two = 2.0 * s,
+        one = s,
+    ))
+}
+
+/// Pixel column of world x / scale in a [`wall`] view.
+pub fn wall_column(x: f32) -> u32 {
+    ((x + 2.5) / 3.0 * WALL_SIZE as f32) as u32
+}
+
+/// Penumbra pixels (0.02 < V < 0.98) down column `x` of a [`wall`] view, across the shadow's +z
+/// side edge.
+pub fn wall_edge_width(c: &Capture, x: u32) -> usize {
+    (WALL_SIZE / 2..WALL_SIZE).filter(|&y| (0.02..0.98).contains(&c.visibility_at(x, y))).count()
+}
+
 /// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
 pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
     let mut frame = settings(s, size, size);
