@@ -12,7 +12,8 @@ fn softshadow() -> Command {
 fn render_writes_images_and_timings() {
     let dir = std::env::temp_dir().join(format!("softshadow-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let (color, vis, timings) = (dir.join("c.png"), dir.join("v.png"), dir.join("t.json"));
+    let (color, vis, timings, trace) =
+        (dir.join("c.png"), dir.join("v.png"), dir.join("t.json"), dir.join("trace.json"));
     let out = softshadow()
         .args([
             "render",
@@ -32,6 +33,8 @@ fn render_writes_images_and_timings() {
         .arg(&vis)
         .arg("--timings")
         .arg(&timings)
+        .arg("--trace")
+        .arg(&trace)
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
@@ -47,7 +50,13 @@ fn render_writes_images_and_timings() {
         assert!(median > 0.0 && p95 >= median, "{p}");
     }
     assert!(t["gpu_ms_total_median"].as_f64().unwrap() > 0.0);
-    assert!(t["cpu_ms"].is_object());
+    assert!(t["cpu_ms"]["record"].as_f64().is_some_and(|ms| ms > 0.0) && t["cpu_ms"]["technique"].is_number());
+
+    // 3 warm-up and 3 timed frames, each with the passes of the timings file.
+    let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    let gpu = check_trace(&trace);
+    assert_eq!(gpu.len(), 6 * names.len());
+    assert!(gpu.iter().all(|(_, _, name)| names.contains(&name.as_str())), "{gpu:?}");
 
     let v = image::open(&vis).unwrap();
     assert_eq!(v.color(), image::ColorType::L16, "visibility is 16-bit grayscale");
@@ -120,6 +129,46 @@ fn compare_refuses_a_non_reference_ground_truth() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("parker"));
 }
 
+/// Checks a Chrome trace file's contract and returns its GPU slices (start µs, µs, name): a GPU
+/// track whose slices never overlap, a CPU track with a slice per frame, and no frame's GPU work
+/// before that frame's submission.
+fn check_trace(path: &std::path::Path) -> Vec<(f64, f64, String)> {
+    let trace: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let events = trace["traceEvents"].as_array().unwrap();
+    let track = |prefix: &str| {
+        events
+            .iter()
+            .find(|e| e["name"] == "thread_name" && e["args"]["name"].as_str().unwrap().starts_with(prefix))
+            .map(|e| e["tid"].clone())
+            .unwrap_or_else(|| panic!("no {prefix} track"))
+    };
+    let (cpu, gpu) = (track("CPU"), track("GPU"));
+    assert_ne!(cpu, gpu);
+    let slices = |tid: &serde_json::Value| -> Vec<&serde_json::Value> {
+        events.iter().filter(|e| e["ph"] == "X" && e["tid"] == *tid).collect()
+    };
+    let (cpu, gpu) = (slices(&cpu), slices(&gpu));
+    let time = |e: &serde_json::Value| (e["ts"].as_f64().unwrap(), e["dur"].as_f64().unwrap());
+    let mut on_gpu: Vec<(f64, f64, String)> =
+        gpu.iter().map(|e| (time(e).0, time(e).1, e["name"].as_str().unwrap().to_string())).collect();
+    on_gpu.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for w in on_gpu.windows(2) {
+        assert!(w[0].1 >= 0.0 && w[1].0 >= w[0].0 + w[0].1 - 1e-3, "GPU slices overlap: {w:?}");
+    }
+    for submit in cpu.iter().filter(|e| e["name"] == "submit") {
+        let frame = &submit["args"]["frame"];
+        let submitted = time(submit).0 + time(submit).1;
+        let first = gpu.iter().filter(|e| e["args"]["frame"] == *frame).map(|e| time(e).0).reduce(f64::min);
+        assert!(
+            first.is_some_and(|t| t >= submitted - 1e-3),
+            "frame {frame}: GPU at {first:?} before submission {submitted}"
+        );
+    }
+    let frames = cpu.iter().filter(|e| e["name"].as_str().unwrap().starts_with("frame ")).count();
+    assert!(frames > 0 && gpu.len() >= frames);
+    on_gpu
+}
+
 #[test]
 fn bench_quick_writes_results_a_report_and_a_plot() {
     let out = std::env::temp_dir().join(format!("softshadow-bench-{}", std::process::id()));
@@ -127,6 +176,8 @@ fn bench_quick_writes_results_a_report_and_a_plot() {
         .args(["bench", "--quick", "--frames", "3", "--reference-samples", "16", "--techniques", "shadow-map,pcss"])
         .arg("--out")
         .arg(&out)
+        .arg("--trace")
+        .arg(out.join("trace.json"))
         .output()
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
@@ -149,5 +200,10 @@ fn bench_quick_writes_results_a_report_and_a_plot() {
     // The references are cached, one per scene, for the next run.
     let cached = std::fs::read_dir(out.join("cache")).unwrap().count();
     assert_eq!(cached, 2);
+    // The trace holds every setting's passes, under a CPU slice per setting.
+    let gpu = check_trace(&out.join("trace.json"));
+    assert!(gpu.iter().any(|s| s.2 == "resolve") && gpu.iter().any(|s| s.2 == "shadow_map"));
+    let trace = std::fs::read_to_string(out.join("trace.json")).unwrap();
+    assert!(trace.contains("\"sphere: pcss\""), "no slice for the sphere's PCSS setting");
     std::fs::remove_dir_all(out).ok();
 }

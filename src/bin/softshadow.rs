@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
-use softshadow::measure::{Metrics, TimingReport, save_difference};
+use softshadow::measure::{Metrics, TimingReport, Trace, save_difference};
 use softshadow::scene::Scene;
 use softshadow::technique::{Params, TECHNIQUES, knobs, reference, traced};
 use softshadow::{Capture, Engine, FrameSettings};
@@ -68,6 +68,9 @@ struct RenderArgs {
     /// Timings JSON.
     #[arg(long)]
     timings: Option<PathBuf>,
+    /// Chrome trace of every frame (GPU passes and CPU work; opens in Perfetto).
+    #[arg(long)]
+    trace: Option<PathBuf>,
 }
 
 #[derive(clap::Args)]
@@ -107,6 +110,9 @@ struct BenchArgs {
     /// Light samples of the reference: its own error must stay far below the techniques'.
     #[arg(long, default_value_t = 256)]
     reference_samples: u32,
+    /// Chrome trace of every timed frame (GPU passes and CPU work; opens in Perfetto).
+    #[arg(long)]
+    trace: Option<PathBuf>,
 }
 
 fn main() {
@@ -155,6 +161,7 @@ fn default_run() -> Result<()> {
         out: Some(out.join("color.png")),
         visibility: Some(out.join("visibility.png")),
         timings: Some(out.join("timings.json")),
+        trace: None,
     };
     let report = render(&args)?;
     println!(
@@ -198,12 +205,14 @@ fn load(args: &SceneArgs) -> Result<(Scene, FrameSettings)> {
 }
 
 /// Renders warm-up frames and `frames` timed frames, the last one captured. Offline techniques
-/// default to one frame without warm-up.
+/// default to one frame without warm-up. With a trace, every frame goes into it, labelled
+/// with `label` and whether it was timed.
 fn render_frames(
     engine: &mut Engine,
     scene: &Scene,
     settings: &FrameSettings,
     frames: Option<usize>,
+    trace: Option<(&mut Trace, &serde_json::Value)>,
 ) -> Result<(Capture, TimingReport)> {
     let offline = settings.params.technique.offline;
     let frames = frames.unwrap_or(if offline { 1 } else { 20 });
@@ -217,7 +226,15 @@ fn render_frames(
     let capture = engine.render_and_capture(scene, settings)?;
     engine.flush()?;
     let timings = engine.take_timings();
-    let measured = &timings[timings.len().saturating_sub(frames)..];
+    let first_measured = timings.len().saturating_sub(frames);
+    let measured = &timings[first_measured..];
+    if let Some((trace, label)) = trace {
+        let mut label = label.clone();
+        label["timed"] = false.into();
+        trace.add_frames(&timings[..first_measured], &label);
+        label["timed"] = true.into();
+        trace.add_frames(measured, &label);
+    }
     let name = settings.params.technique.name;
     let report = TimingReport::new(engine.device(), name, settings.width, settings.height, measured);
     Ok((capture, report))
@@ -234,7 +251,17 @@ fn finish(engine: Engine) -> Result<()> {
 fn render(args: &RenderArgs) -> Result<TimingReport> {
     let (scene, settings) = load(&args.what)?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    let (capture, report) = render_frames(&mut engine, &scene, &settings, args.what.frames)?;
+    let mut trace = args.trace.as_ref().map(|_| Trace::new(&engine.device().name));
+    let label = serde_json::json!({
+        "scene": args.what.scene,
+        "technique": settings.params.technique.name,
+        "params": settings.params.to_string(),
+    });
+    let (capture, report) =
+        render_frames(&mut engine, &scene, &settings, args.what.frames, trace.as_mut().map(|t| (t, &label)))?;
+    if let (Some(trace), Some(p)) = (&trace, &args.trace) {
+        trace.write(p)?;
+    }
     if let Some(p) = &args.out {
         capture.save_color(p)?;
     }
@@ -260,8 +287,8 @@ fn compare(args: &CompareArgs) -> Result<()> {
     apply_sets(&mut truth.params, &args.against_set)?;
 
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    let (capture, report) = render_frames(&mut engine, &scene, &settings, args.what.frames)?;
-    let (reference, reference_report) = render_frames(&mut engine, &scene, &truth, None)?;
+    let (capture, report) = render_frames(&mut engine, &scene, &settings, args.what.frames, None)?;
+    let (reference, reference_report) = render_frames(&mut engine, &scene, &truth, None, None)?;
     let metrics = Metrics::between(&capture, &reference)?;
     if let Some(p) = &args.diff {
         save_difference(&capture, &reference, p)?;
@@ -342,6 +369,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
     let cache = args.out.join("cache");
     std::fs::create_dir_all(&cache).with_context(|| format!("creating {}", cache.display()))?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let mut trace = args.trace.as_ref().map(|_| Trace::new(&engine.device().name));
     let bar = indicatif::ProgressBar::new((scenes.len() * (runs.len() + 1)) as u64);
     let mut rows = Vec::new();
     for path in &scenes {
@@ -368,7 +396,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         let truth = match load_reference(&cached, size, size) {
             Some(c) => c,
             None => {
-                let (c, _) = render_frames(&mut engine, &scene, &truth_settings, None)?;
+                let (c, _) = render_frames(&mut engine, &scene, &truth_settings, None, None)?;
                 save_reference(&c, &cached)?;
                 c
             }
@@ -379,9 +407,16 @@ fn bench(args: &BenchArgs) -> Result<()> {
             let mut settings =
                 FrameSettings { params: Params::defaults(knobs::find(technique)?), ..truth_settings.clone() };
             settings.params.apply(sets.iter().copied())?;
-            let (capture, timings) = render_frames(&mut engine, &scene, &settings, Some(args.frames))?;
-            let metrics = Metrics::between(&capture, &truth)?;
             let setting = sets.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+            let label = serde_json::json!({"scene": name, "technique": technique, "setting": setting});
+            let started = std::time::Instant::now();
+            let (capture, timings) =
+                render_frames(&mut engine, &scene, &settings, Some(args.frames), trace.as_mut().map(|t| (t, &label)))?;
+            if let Some(trace) = &mut trace {
+                let title = format!("{name}: {technique} {setting}");
+                trace.cpu_slice(title.trim_end(), started, std::time::Instant::now(), label);
+            }
+            let metrics = Metrics::between(&capture, &truth)?;
             rows.push(BenchRow {
                 scene: name.clone(),
                 technique: technique.to_string(),
@@ -400,6 +435,10 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
+    if let (Some(trace), Some(p)) = (&trace, &args.trace) {
+        trace.write(p)?;
+        println!("wrote {}", p.display());
+    }
     println!("wrote {0}/results.csv, {0}/report.md, {0}/tradeoff.png", args.out.display());
     Ok(())
 }

@@ -104,12 +104,7 @@ impl FrameRing {
     }
 
     /// [`FrameRing::wait`], calling `tick` every tenth of a second while the frame runs.
-    pub fn wait_ticking(
-        &mut self,
-        ctx: &Context,
-        slot: usize,
-        tick: &mut dyn FnMut(),
-    ) -> Result<Option<Vec<PassTime>>> {
+    fn wait_ticking(&mut self, ctx: &Context, slot: usize, tick: &mut dyn FnMut()) -> Result<Option<Vec<PassTime>>> {
         let s = &mut self.slots[slot];
         const TICK_NS: u64 = 100_000_000;
         while unsafe { ctx.device.wait_for_fences(&[s.fence], true, TICK_NS) } == Err(vk::Result::TIMEOUT) {
@@ -121,10 +116,15 @@ impl FrameRing {
 
     /// Waits for every frame in flight; returns their pass times, oldest first.
     pub fn drain(&mut self, ctx: &Context) -> Result<Vec<Vec<PassTime>>> {
+        self.drain_ticking(ctx, &mut || {})
+    }
+
+    /// [`FrameRing::drain`], calling `tick` every tenth of a second while a frame runs.
+    pub fn drain_ticking(&mut self, ctx: &Context, tick: &mut dyn FnMut()) -> Result<Vec<Vec<PassTime>>> {
         let mut out = Vec::new();
         for k in 0..FRAMES_IN_FLIGHT {
             let slot = (self.next + k) % FRAMES_IN_FLIGHT;
-            out.extend(self.wait(ctx, slot)?);
+            out.extend(self.wait_ticking(ctx, slot, tick)?);
         }
         Ok(out)
     }

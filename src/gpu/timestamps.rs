@@ -14,6 +14,8 @@ const MAX_PASSES: u32 = 32;
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
     pub name: &'static str,
+    /// When the pass began on the GPU's clock (arbitrary origin; only differences mean anything).
+    pub begin_ms: f64,
     pub ms: f64,
 }
 
@@ -88,6 +90,7 @@ impl PassTimer {
                 .zip(raw.chunks_exact(2))
                 .map(|(&name, t)| PassTime {
                     name,
+                    begin_ms: (t[0] & mask) as f64 * period * 1e-6,
                     ms: ((t[1] & mask).wrapping_sub(t[0] & mask) & mask) as f64 * period * 1e-6,
                 })
                 .collect(),

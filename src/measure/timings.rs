@@ -28,6 +28,9 @@ pub struct TimingReport {
     pub gpu_ms_total_median: f64,
     /// Beyond DESIGN.md's contract: the 95th percentile of the per-frame totals.
     pub gpu_ms_total_p95: f64,
+    /// Medians: `record` (recording to submission) and each CPU span of
+    /// [`FrameTimings::cpu`](crate::renderer::FrameTimings::cpu), `technique` being the
+    /// technique's per-frame geometry and recording.
     pub cpu_ms: BTreeMap<String, f64>,
 }
 
@@ -61,7 +64,16 @@ impl TimingReport {
             })
             .collect();
         let totals: Vec<f64> = frames.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect();
-        let cpu: Vec<f64> = frames.iter().map(|f| f.cpu_record_ms).collect();
+        let record: Vec<f64> = frames.iter().map(FrameTimings::cpu_record_ms).collect();
+        let mut cpu_ms = BTreeMap::from([("record".to_string(), percentile(&record, 0.5))]);
+        let mut span_names: Vec<&'static str> = frames.iter().flat_map(|f| f.cpu.iter().map(|s| s.name)).collect();
+        span_names.sort_unstable();
+        span_names.dedup();
+        for name in span_names {
+            let ms: Vec<f64> =
+                frames.iter().flat_map(|f| f.cpu.iter().filter(|s| s.name == name).map(|s| s.ms)).collect();
+            cpu_ms.insert(name.to_string(), percentile(&ms, 0.5));
+        }
         TimingReport {
             device: device.name.clone(),
             driver: device.driver.clone(),
@@ -72,7 +84,7 @@ impl TimingReport {
             passes,
             gpu_ms_total_median: percentile(&totals, 0.5),
             gpu_ms_total_p95: percentile(&totals, 0.95),
-            cpu_ms: BTreeMap::from([("record".to_string(), percentile(&cpu, 0.5))]),
+            cpu_ms,
         }
     }
 }

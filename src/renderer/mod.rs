@@ -54,11 +54,60 @@ impl FrameSettings {
     }
 }
 
-/// GPU pass times of one finished frame, and the CPU time its recording took.
+/// GPU pass times of one finished frame, and the CPU work that made it.
 #[derive(Clone, Debug)]
 pub struct FrameTimings {
     pub passes: Vec<PassTime>,
-    pub cpu_record_ms: f64,
+    /// In order: [`WAIT_FOR_SLOT`], `draw list`, `prepass`, `technique` (its per-frame geometry
+    /// and recording), `composite`, [`SUBMIT`]; a captured frame adds `wait for GPU` and
+    /// `readback`.
+    pub cpu: Vec<CpuSpan>,
+}
+
+/// A stretch of CPU work on the host's clock.
+#[derive(Clone, Debug)]
+pub struct CpuSpan {
+    pub name: &'static str,
+    pub start: Instant,
+    pub ms: f64,
+}
+
+/// The CPU span spent waiting for a frame slot's previous frame (not recording work).
+pub const WAIT_FOR_SLOT: &str = "wait for slot";
+/// The CPU span that ends with the frame's submission.
+pub const SUBMIT: &str = "submit";
+
+impl FrameTimings {
+    /// CPU ms from the start of recording to the submission.
+    pub fn cpu_record_ms(&self) -> f64 {
+        let spans = || self.cpu.iter().skip_while(|s| s.name == WAIT_FOR_SLOT);
+        let until_submit = spans().position(|s| s.name == SUBMIT).map_or(0, |i| i + 1);
+        spans().take(until_submit).map(|s| s.ms).sum()
+    }
+
+    /// When the frame was submitted, on the host's clock.
+    pub fn submitted(&self) -> Option<Instant> {
+        self.cpu.iter().find(|s| s.name == SUBMIT).map(|s| s.start + std::time::Duration::from_secs_f64(s.ms * 1e-3))
+    }
+}
+
+/// Cuts a frame's CPU time into consecutive named spans.
+struct SpanClock {
+    spans: Vec<CpuSpan>,
+    last: Instant,
+}
+
+impl SpanClock {
+    fn start() -> Self {
+        SpanClock { spans: Vec::new(), last: Instant::now() }
+    }
+
+    /// Ends the span that began at the previous mark.
+    fn mark(&mut self, name: &'static str) {
+        let now = Instant::now();
+        self.spans.push(CpuSpan { name, start: self.last, ms: (now - self.last).as_secs_f64() * 1e3 });
+        self.last = now;
+    }
 }
 
 /// The camera-sized targets every technique shares.
@@ -127,7 +176,8 @@ pub struct Engine {
     ground_mesh: Arc<Mesh>,
     frame_number: u64,
     timings: Vec<FrameTimings>,
-    cpu_ms: Vec<f64>,
+    /// CPU spans of submitted frames whose GPU times have not come back yet, oldest first.
+    cpu_spans: std::collections::VecDeque<Vec<CpuSpan>>,
     // Declared last: dropped after everything above is destroyed in `Drop`.
     ctx: Context,
 }
@@ -149,7 +199,7 @@ impl Engine {
             ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
             frame_number: 0,
             timings: Vec::new(),
-            cpu_ms: Vec::new(),
+            cpu_spans: Default::default(),
             ctx,
         };
         // On error, `Drop` destroys whatever was made.
@@ -205,8 +255,8 @@ impl Engine {
 
     fn push_timings(&mut self, done: impl IntoIterator<Item = Vec<PassTime>>) {
         for passes in done {
-            let cpu_record_ms = if self.cpu_ms.is_empty() { 0.0 } else { self.cpu_ms.remove(0) };
-            self.timings.push(FrameTimings { passes, cpu_record_ms });
+            let cpu = self.cpu_spans.pop_front().unwrap_or_default();
+            self.timings.push(FrameTimings { passes, cpu });
         }
     }
 
@@ -218,8 +268,9 @@ impl Engine {
 
         let ctx = &self.ctx;
         let frames = self.frames.as_mut().expect("engine is built");
+        let mut clock = SpanClock::start();
         let (mut frame, earlier) = frames.begin(ctx)?;
-        let started = Instant::now();
+        clock.mark(WAIT_FOR_SLOT);
         let number = self.frame_number;
         self.frame_number += 1;
         // The fence just waited on covers every frame up to `number - FRAMES_IN_FLIGHT`.
@@ -285,8 +336,10 @@ impl Engine {
         let objects_range = object_buffer.range(frame.slot);
         let receivers = receivers_in_view(&camera.frustum, &draws);
 
+        clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
         self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, [globals_range, objects_range], &draws);
+        clock.mark("prepass");
         let (_, technique) = self.technique.as_mut().expect("ensured");
         let mut inputs = FrameInputs {
             ctx,
@@ -303,6 +356,7 @@ impl Engine {
             receivers_in_view: &receivers,
         };
         technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
+        clock.mark("technique");
         self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range);
         if capture {
             let size = capture::readback_size(w, h);
@@ -330,17 +384,19 @@ impl Engine {
         let slot = frame.slot;
         let frames = self.frames.as_mut().expect("engine is built");
         frames.submit(ctx, slot)?;
-        self.cpu_ms.push(started.elapsed().as_secs_f64() * 1e3);
+        clock.mark(SUBMIT);
         self.push_timings(earlier);
         if !capture {
+            self.cpu_spans.push_back(clock.spans);
             return Ok(None);
         }
         let frames = self.frames.as_mut().expect("engine is built");
         let technique = &self.technique.as_ref().expect("ensured").1;
         let (mut bar, mut ticks) = (None, 0);
-        // A frame of many seconds (the reference at high sample counts) shows a progress bar on
-        // a terminal after half a second; indicatif draws nothing when stderr is not one.
-        let done = frames.wait_ticking(&self.ctx, slot, &mut || {
+        // Waits oldest first, so timings stay in submission order. A frame of many seconds (the
+        // reference at high sample counts) shows a progress bar on a terminal after half a
+        // second; indicatif draws nothing when stderr is not one.
+        let done = frames.drain_ticking(&self.ctx, &mut || {
             ticks += 1;
             if ticks < 5 {
                 return;
@@ -353,13 +409,16 @@ impl Engine {
         if let Some(bar) = bar {
             bar.finish_and_clear();
         }
-        self.push_timings(done);
+        clock.mark("wait for GPU");
         let mut capture = Capture::read(self.readback.as_ref().expect("ensured"), w, h, &camera);
         if let Some((_, t)) = &self.technique
             && let Some(surfaces) = t.traced_surfaces()
         {
             capture.surfaces = surfaces.clone();
         }
+        clock.mark("readback");
+        self.cpu_spans.push_back(clock.spans);
+        self.push_timings(done);
         Ok(Some(capture))
     }
 
