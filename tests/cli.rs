@@ -207,3 +207,41 @@ fn bench_quick_writes_results_a_report_and_a_plot() {
     assert!(trace.contains("\"sphere: pcss\""), "no slice for the sphere's PCSS setting");
     std::fs::remove_dir_all(out).ok();
 }
+
+#[test]
+fn showcase_renders_every_technique_with_a_labelled_contact_sheet() {
+    let out = std::env::temp_dir().join(format!("softshadow-showcase-{}", std::process::id()));
+    let run = softshadow()
+        .args(["showcase", "scenes/plate.toml", "--width", "64", "--height", "64", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let listed = String::from_utf8(softshadow().arg("techniques").output().unwrap().stdout).unwrap();
+    let names: Vec<&str> =
+        listed.lines().filter(|l| !l.starts_with(' ')).map(|l| l.split(':').next().unwrap()).collect();
+    assert_eq!(names.len(), 8, "{listed}");
+    // A table row per technique: GPU ms, CPU ms, then RMSE and penumbra RMSE (the truth has none).
+    let row = |name: &str| -> Vec<f64> {
+        let line = stdout
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no row for {name}:\n{stdout}"));
+        line.split_whitespace().skip(1).filter_map(|x| x.parse().ok()).collect()
+    };
+    for name in &names {
+        let values = row(name);
+        assert!(values.len() >= 2 && values.iter().all(|v| v.is_finite() && *v >= 0.0), "{name}: {values:?}");
+        for file in ["color.png", "visibility.png", "timings.json"] {
+            assert!(out.join(name).join(file).is_file(), "{name}/{file} missing");
+        }
+    }
+    assert_eq!(row("raytrace").len(), 2, "the ground truth has no error row");
+    // The sampled reference and PCSS are nearer the truth than the hard shadow map.
+    let rmse = |name| row(name)[2];
+    assert!(rmse("reference") < rmse("shadow-map") && rmse("pcss") < rmse("shadow-map"), "{stdout}");
+    let sheet = image::open(out.join("contact_sheet.png")).unwrap();
+    assert_eq!((sheet.width(), sheet.height()), (4 * 64, 2 * (64 + 48)));
+    std::fs::remove_dir_all(out).ok();
+}

@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::{Metrics, TimingReport, Trace, save_difference};
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, TECHNIQUES, knobs, reference, traced};
+use softshadow::technique::{Params, TECHNIQUES, TechniqueInfo, knobs, reference, traced};
 use softshadow::{Capture, Engine, FrameSettings};
 
 /// Frames rendered before timing starts (pipelines warm, caches filled).
@@ -29,6 +29,10 @@ enum Command {
     /// The speed/accuracy sweep: every technique and setting on every scene, against the
     /// reference; writes results.csv, report.md and tradeoff.png.
     Bench(BenchArgs),
+    /// Every technique on one scene, side by side: a contact sheet labelled with GPU ms and
+    /// the error against the CPU ray tracer, and the same table printed. `softshadow` with no
+    /// arguments runs it on the default scene into out/.
+    Showcase(ShowcaseArgs),
     /// List the techniques and their knobs with defaults.
     Techniques,
     /// Show the Vulkan device, driver and limits.
@@ -115,6 +119,20 @@ struct BenchArgs {
     trace: Option<PathBuf>,
 }
 
+#[derive(clap::Parser)]
+struct ShowcaseArgs {
+    /// The scene file (TOML).
+    #[arg(default_value = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/default.toml"))]
+    scene: PathBuf,
+    /// Output folder: contact_sheet.png and a folder per technique.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+}
+
 fn main() {
     if let Err(e) = run(Cli::parse()) {
         eprintln!("softshadow: {e:#}");
@@ -127,6 +145,7 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(args)) => render(&args).map(|_| ()),
         Some(Command::Compare(args)) => compare(&args),
         Some(Command::Bench(args)) => bench(&args),
+        Some(Command::Showcase(args)) => showcase(&args),
         Some(Command::Techniques) => {
             for t in TECHNIQUES {
                 println!("{}: {}", t.name, t.summary);
@@ -147,34 +166,106 @@ fn run(cli: Cli) -> Result<()> {
             println!("timestamp period:     {} ns, {} valid bits", d.timestamp_period_ns, d.timestamp_valid_bits);
             Ok(())
         }
-        None => default_run(),
+        None => showcase(&ShowcaseArgs::parse_from(["softshadow showcase"])),
     }
 }
 
-/// `softshadow` alone: the default scene into out/, with a table of GPU ms per pass.
-fn default_run() -> Result<()> {
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/default.toml");
-    let out = PathBuf::from("out");
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let args = RenderArgs {
-        what: SceneArgs { scene, technique: None, set: Vec::new(), width: None, height: None, frames: None },
-        out: Some(out.join("color.png")),
-        visibility: Some(out.join("visibility.png")),
-        timings: Some(out.join("timings.json")),
-        trace: None,
+/// `showcase`: every technique on one scene, against the CPU ray tracer.
+fn showcase(args: &ShowcaseArgs) -> Result<()> {
+    use softshadow::measure::{Tile, contact_sheet};
+    let what = SceneArgs {
+        scene: args.scene.clone(),
+        technique: None,
+        set: Vec::new(),
+        width: args.width,
+        height: args.height,
+        frames: None,
     };
-    let report = render(&args)?;
-    println!(
-        "{} on {} ({}), {}x{}, median of {} frames",
-        report.technique, report.device, report.driver, report.width, report.height, report.frames
-    );
-    println!("{:<12} {:>10} {:>10}", "pass", "GPU ms", "p95 ms");
-    for p in &report.passes {
-        println!("{:<12} {:>10.3} {:>10.3}", p.name, p.gpu_ms_median, p.gpu_ms_p95);
+    let (scene, base) = load(&what)?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let bar = indicatif::ProgressBar::new(TECHNIQUES.len() as u64);
+    let truth_info = &traced::RAYTRACE;
+    bar.set_message(truth_info.name);
+    let truth_settings = FrameSettings { params: Params::defaults(truth_info), ..base.clone() };
+    let truth = render_frames(&mut engine, &scene, &truth_settings, None, None)?;
+    let mut rows: Vec<(&TechniqueInfo, Capture, TimingReport, Option<Metrics>)> = Vec::new();
+    for &info in TECHNIQUES {
+        bar.set_message(info.name);
+        let (capture, report, metrics) = if info.name == truth_info.name {
+            (truth.0.clone(), truth.1.clone(), None)
+        } else {
+            let settings = FrameSettings { params: Params::defaults(info), ..base.clone() };
+            let (capture, report) = render_frames(&mut engine, &scene, &settings, None, None)?;
+            let metrics = Metrics::between(&capture, &truth.0)?;
+            (capture, report, Some(metrics))
+        };
+        let dir = args.out.join(info.name);
+        std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        capture.save_color(&dir.join("color.png"))?;
+        capture.save_visibility(&dir.join("visibility.png"))?;
+        write_json(&report, &dir.join("timings.json"))?;
+        rows.push((info, capture, report, metrics));
+        bar.inc(1);
     }
-    println!("{:<12} {:>10.3}", "total", report.gpu_ms_total_median);
-    println!("wrote out/color.png, out/visibility.png, out/timings.json");
+    bar.finish_and_clear();
+    finish(engine)?;
+
+    let cpu = |r: &TimingReport| r.cpu_ms.get("technique").copied().unwrap_or(0.0);
+    let tiles: Vec<Tile> = rows
+        .iter()
+        .map(|(info, capture, report, metrics)| Tile {
+            title: info.name.to_string(),
+            detail: match metrics {
+                Some(m) => format!(
+                    "GPU {:.1} ms, CPU {:.1} ms, RMSE {:.4}, penumbra {:.3}",
+                    report.gpu_ms_total_median,
+                    cpu(report),
+                    m.rmse,
+                    m.penumbra_rmse
+                ),
+                None => format!("ground truth, CPU {:.0} ms", cpu(report)),
+            },
+            capture,
+        })
+        .collect();
+    let sheet = args.out.join("contact_sheet.png");
+    contact_sheet(&tiles, 4, &sheet)?;
+
+    let first = &rows[0].2;
+    println!(
+        "{}, {}x{}, {} ({}); GPU and CPU ms: medians of 20 frames after 3 warm-up (offline techniques: 1 frame); \
+         error against {} [{}]",
+        args.scene.display(),
+        first.width,
+        first.height,
+        first.device,
+        first.driver,
+        truth_info.name,
+        truth_settings.params
+    );
+    println!(
+        "{:<12} {:>10} {:>10} {:>9} {:>10} {:>9} {:>9}",
+        "technique", "GPU ms", "CPU ms", "RMSE", "penumbra", "leak", "dark"
+    );
+    for (info, _, report, metrics) in &rows {
+        let errors = match metrics {
+            Some(m) => format!("{:>9.4} {:>10.4} {:>9.4} {:>9.4}", m.rmse, m.penumbra_rmse, m.leak_rate, m.dark_rate),
+            None => format!("{:>9}", "(truth)"),
+        };
+        println!("{:<12} {:>10.2} {:>10.2} {errors}", info.name, report.gpu_ms_total_median, cpu(report));
+    }
+    println!(
+        "wrote {} and per technique {}/<technique>/{{color,visibility}}.png, timings.json",
+        sheet.display(),
+        args.out.display()
+    );
     Ok(())
+}
+
+fn write_json(value: &impl serde::Serialize, path: &Path) -> Result<()> {
+    let json = serde_json::to_string_pretty(value)?;
+    std::fs::write(path, json + "\n").with_context(|| format!("writing {}", path.display()))
 }
 
 /// Applies `KEY=VALUE` pairs to `params`.
@@ -269,8 +360,7 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
         capture.save_visibility(p)?;
     }
     if let Some(p) = &args.timings {
-        let json = serde_json::to_string_pretty(&report)?;
-        std::fs::write(p, json + "\n").with_context(|| format!("writing {}", p.display()))?;
+        write_json(&report, p)?;
     }
     finish(engine)?;
     Ok(report)

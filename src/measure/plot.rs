@@ -23,16 +23,25 @@ const COLORS: [RGBColor; 8] = [
     RGBColor(23, 190, 207),
 ];
 
-fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Invalid(format!("plotting {}: {e}", path.display()))
+pub(super) fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Invalid(format!("drawing {}: {e}", path.display()))
+}
+
+/// Registers DejaVu Sans as plotters' "sans-serif", once per process (plotters keeps
+/// registered fonts for the process's life).
+pub(super) fn register_sans(path: &Path) -> Result<()> {
+    static REGISTERED: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
+    let registered = REGISTERED.get_or_init(|| {
+        let font = std::fs::read(FONT).map_err(|e| format!("reading {FONT}: {e}"))?;
+        register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
+            .map_err(|_| format!("{FONT} is not a font plotters can read"))
+    });
+    registered.clone().map_err(|e| plot_error(path, e))
 }
 
 /// Draws every row, a colour per technique, and each scene's Pareto frontier as a line.
 pub fn tradeoff(rows: &[BenchRow], path: &Path) -> Result<()> {
-    let font = std::fs::read(FONT).map_err(|source| Error::Io { path: FONT.into(), source })?;
-    // plotters keeps registered fonts for the process's life.
-    register_font("sans-serif", FontStyle::Normal, Box::leak(font.into_boxed_slice()))
-        .map_err(|_| plot_error(path, "cannot read DejaVu Sans"))?;
+    register_sans(path)?;
     let max_ms = rows.iter().map(|r| r.timings.gpu_ms_total_median).fold(1.0, f64::max) * 1.1;
     let max_err = rows.iter().map(|r| r.metrics.penumbra_rmse).fold(0.05, f64::max) * 1.1;
     let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
