@@ -117,6 +117,10 @@ struct BenchArgs {
     /// Chrome trace of every timed frame (GPU passes and CPU work; opens in Perfetto).
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Instead of the trade: the stability sweep's long grids (every axis, up to 4096²),
+    /// written to DIR/extremes.csv; fails if any check fails.
+    #[arg(long, conflicts_with_all = ["scenes", "quick", "trace"])]
+    extremes: bool,
 }
 
 #[derive(clap::Parser)]
@@ -429,8 +433,35 @@ fn compare(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+/// `bench --extremes`: the long grids of measure::extremes.
+fn extremes(args: &BenchArgs) -> Result<()> {
+    use softshadow::measure::extremes::{Axis, problems, sweep, write_csv};
+    let techniques = args.techniques.iter().map(|t| knobs::find(t)).collect::<Result<Vec<_>, _>>()?;
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let bar = indicatif::ProgressBar::new_spinner();
+    let mut rows = Vec::new();
+    for axis in Axis::ALL {
+        rows.extend(sweep(&mut engine, axis, true, &techniques, &mut |label| bar.set_message(label.to_string()))?);
+    }
+    bar.finish_and_clear();
+    finish(engine)?;
+    let csv = args.out.join("extremes.csv");
+    write_csv(&rows, &csv)?;
+    println!("wrote {} ({} renders)", csv.display(), rows.len());
+    let problems = problems(&rows);
+    if !problems.is_empty() {
+        bail!("{} stability problem(s):\n{}", problems.len(), problems.join("\n"));
+    }
+    println!("no NaN, V within [0, 1], continuous along every axis");
+    Ok(())
+}
+
 /// `bench`: the sweep of measure::bench over the scene suite.
 fn bench(args: &BenchArgs) -> Result<()> {
+    if args.extremes {
+        return extremes(args);
+    }
     use softshadow::measure::bench::{
         BenchRow, load_reference, mark_pareto, save_reference, sweep, write_csv, write_report,
     };

@@ -171,6 +171,7 @@ pub fn load_reference(path: &Path, width: u32, height: u32) -> Option<Capture> {
         height,
         color: vec![0; n * 4],
         visibility: Vec::with_capacity(n),
+        raw_visibility: None,
         surfaces: Surfaces {
             depth: Vec::with_capacity(n),
             normal: Vec::with_capacity(n),

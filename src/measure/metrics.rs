@@ -147,6 +147,7 @@ mod tests {
             height: 1,
             color: vec![0; v.len() * 4],
             visibility: v.iter().map(|x| (x * 65535.0).round() as u16).collect(),
+            raw_visibility: None,
             surfaces: Surfaces {
                 depth: depth.to_vec(),
                 normal: vec![glam::Vec3::Y; v.len()],

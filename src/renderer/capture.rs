@@ -6,23 +6,27 @@ use std::path::Path;
 use ash::vk;
 use glam::{Vec2, Vec3};
 
-use super::CameraTargets;
+use super::{CameraTargets, RAW_VISIBILITY_FORMAT};
 use crate::error::{Error, Result};
 use crate::geometry::CameraProjection;
 use crate::gpu::{Buffer, Context};
 
-/// Bytes per pixel read back: RGBA8 color, D32 depth, RGBA16F normal + receives, R16 V.
-const PIXEL_BYTES: [u64; 4] = [4, 4, 8, 2];
+/// Bytes per pixel read back: RGBA8 color, D32 depth, RGBA16F normal + receives, then V: R16,
+/// or R32F for raw visibility.
+fn pixel_bytes(visibility: vk::Format) -> [u64; 4] {
+    [4, 4, 8, if visibility == RAW_VISIBILITY_FORMAT { 4 } else { 2 }]
+}
 
-pub(super) fn readback_size(w: u32, h: u32) -> u64 {
-    w as u64 * h as u64 * PIXEL_BYTES.iter().sum::<u64>()
+pub(super) fn readback_size(w: u32, h: u32, visibility: vk::Format) -> u64 {
+    w as u64 * h as u64 * pixel_bytes(visibility).iter().sum::<u64>()
 }
 
 pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTargets, dst: &Buffer) {
     let extent = t.color.extent();
     let pixels = extent.width as u64 * extent.height as u64;
     let mut offset = 0;
-    for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(PIXEL_BYTES) {
+    let bytes = pixel_bytes(t.visibility.desc.format);
+    for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
         let region = target.whole_copy(offset);
         unsafe {
             ctx.device.cmd_copy_image_to_buffer(
@@ -35,6 +39,12 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
         };
         offset += pixels * bytes;
     }
+}
+
+/// V as R16_UNORM stores it: clamped to [0, 1], rounded; NaN becomes 0 (Vulkan's conversion
+/// to normalized fixed point).
+pub fn quantize(v: f32) -> u16 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
 }
 
 /// The surfaces a visibility image was estimated at.
@@ -83,16 +93,25 @@ pub struct Capture {
     pub color: Vec<u8>,
     /// V as round(V · 65535); 1 (65535) where no surface is seen.
     pub visibility: Vec<u16>,
+    /// V as the technique wrote it, before quantisation (NaN and values outside [0, 1]
+    /// included), when the engine keeps raw visibility ([`Engine::set_raw_visibility`](super::Engine::set_raw_visibility)).
+    pub raw_visibility: Option<Vec<f32>>,
     /// Where V was estimated: the prepass's surfaces, or the ones a ray tracer found.
     pub surfaces: Surfaces,
 }
 
 impl Capture {
-    pub(super) fn read(buffer: &Buffer, width: u32, height: u32, camera: &CameraProjection) -> Self {
+    pub(super) fn read(
+        buffer: &Buffer,
+        width: u32,
+        height: u32,
+        camera: &CameraProjection,
+        visibility_format: vk::Format,
+    ) -> Self {
         let n = width as usize * height as usize;
         let mut parts = Vec::new();
         let mut rest = buffer.read();
-        for bytes in PIXEL_BYTES {
+        for bytes in pixel_bytes(visibility_format) {
             let (part, tail) = rest.split_at(n * bytes as usize);
             parts.push(part);
             rest = tail;
@@ -118,8 +137,14 @@ impl Capture {
         // The normal target's alpha (a half float, 0, 0.5 or 1) is the shadow role; positive
         // halfs order like their bits.
         let receives = parts[2].chunks_exact(8).map(|b| halfs(b)[3] > HALF_QUARTER).collect();
-        let visibility = parts[3].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect();
-        Capture { width, height, color, visibility, surfaces: Surfaces { depth, normal, receives } }
+        let (visibility, raw_visibility) = if visibility_format == RAW_VISIBILITY_FORMAT {
+            let raw: Vec<f32> =
+                parts[3].chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
+            (raw.iter().map(|&v| quantize(v)).collect(), Some(raw))
+        } else {
+            (parts[3].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect(), None)
+        };
+        Capture { width, height, color, visibility, raw_visibility, surfaces: Surfaces { depth, normal, receives } }
     }
 
     /// V at pixel (x, y) in [0, 1].

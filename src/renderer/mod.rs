@@ -14,7 +14,7 @@ use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
-pub use capture::{Capture, Surfaces, pixel_uv};
+pub use capture::{Capture, Surfaces, pixel_uv, quantize};
 pub use draw::Draw;
 use draw::MeshCache;
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
@@ -31,6 +31,9 @@ use crate::technique::{self, FrameInputs, Params, Technique};
 
 /// Format of the visibility image V (DESIGN.md §3).
 pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R16_UNORM;
+/// V's format when the engine keeps raw visibility: UNORM would clamp values outside [0, 1]
+/// and turn NaN into 0 silently, hiding exactly what the stability checks look for.
+pub const RAW_VISIBILITY_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
 const AMBIENT: f32 = 0.15;
 const SKY: [f32; 3] = [0.55, 0.62, 0.72];
@@ -123,7 +126,7 @@ pub struct CameraTargets {
 }
 
 impl CameraTargets {
-    fn new(ctx: &Context, w: u32, h: u32) -> Result<Self> {
+    fn new(ctx: &Context, w: u32, h: u32, visibility: vk::Format) -> Result<Self> {
         let sampled = vk::ImageUsageFlags::SAMPLED;
         let readback = vk::ImageUsageFlags::TRANSFER_SRC;
         let descs = [
@@ -132,8 +135,7 @@ impl CameraTargets {
             TargetDesc::color("camera shading normal", SHADING_FORMAT, w, h),
             TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
             // CPU techniques (`raytrace`, `parker`) copy V in.
-            TargetDesc::color("visibility", VISIBILITY_FORMAT, w, h)
-                .usage(readback | vk::ImageUsageFlags::TRANSFER_DST),
+            TargetDesc::color("visibility", visibility, w, h).usage(readback | vk::ImageUsageFlags::TRANSFER_DST),
             TargetDesc::color("color", COLOR_FORMAT, w, h).usage(readback),
         ];
         let mut made = Vec::new();
@@ -173,6 +175,7 @@ pub struct Engine {
     targets: Option<CameraTargets>,
     readback: Option<Buffer>,
     technique: Option<(&'static str, Box<dyn Technique>)>,
+    visibility_format: vk::Format,
     ground_mesh: Arc<Mesh>,
     frame_number: u64,
     timings: Vec<FrameTimings>,
@@ -196,6 +199,7 @@ impl Engine {
             targets: None,
             readback: None,
             technique: None,
+            visibility_format: VISIBILITY_FORMAT,
             ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
             frame_number: 0,
             timings: Vec::new(),
@@ -211,6 +215,20 @@ impl Engine {
         engine.globals =
             Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
         Ok(engine)
+    }
+
+    /// Keeps V in 32-bit float so that captures carry it raw
+    /// ([`Capture::raw_visibility`]): a diagnostic for stability checks, off by default because
+    /// DESIGN.md's V is R16_UNORM. Switching rebuilds the targets and the technique.
+    pub fn set_raw_visibility(&mut self, raw: bool) -> Result<()> {
+        let format = if raw { RAW_VISIBILITY_FORMAT } else { VISIBILITY_FORMAT };
+        if format != self.visibility_format {
+            self.ctx.wait_idle()?;
+            self.targets.take().into_iter().for_each(|t| t.destroy(&self.ctx));
+            self.technique.take().into_iter().for_each(|(_, t)| t.destroy(&self.ctx));
+            self.visibility_format = format;
+        }
+        Ok(())
     }
 
     pub fn device(&self) -> &DeviceInfo {
@@ -359,7 +377,7 @@ impl Engine {
         clock.mark("technique");
         self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range);
         if capture {
-            let size = capture::readback_size(w, h);
+            let size = capture::readback_size(w, h, self.visibility_format);
             if self.readback.as_ref().is_none_or(|b| b.size != size) {
                 if let Some(old) = self.readback.take() {
                     old.destroy(ctx);
@@ -410,7 +428,8 @@ impl Engine {
             bar.finish_and_clear();
         }
         clock.mark("wait for GPU");
-        let mut capture = Capture::read(self.readback.as_ref().expect("ensured"), w, h, &camera);
+        let readback = self.readback.as_ref().expect("ensured");
+        let mut capture = Capture::read(readback, w, h, &camera, self.visibility_format);
         if let Some((_, t)) = &self.technique
             && let Some(surfaces) = t.traced_surfaces()
         {
@@ -430,7 +449,7 @@ impl Engine {
             self.ctx.wait_idle()?;
             old.destroy(&self.ctx);
         }
-        self.targets = Some(CameraTargets::new(&self.ctx, w, h)?);
+        self.targets = Some(CameraTargets::new(&self.ctx, w, h, self.visibility_format)?);
         Ok(())
     }
 
@@ -442,7 +461,7 @@ impl Engine {
             self.ctx.wait_idle()?;
             old.destroy(&self.ctx);
         }
-        self.technique = Some((info.name, technique::create(&self.ctx, info)?));
+        self.technique = Some((info.name, technique::create(&self.ctx, info, self.visibility_format)?));
         Ok(())
     }
 

@@ -59,14 +59,14 @@ pub trait Technique {
 }
 
 /// Creates the technique `info` names.
-pub fn create(ctx: &Context, info: &'static TechniqueInfo) -> Result<Box<dyn Technique>> {
+pub fn create(ctx: &Context, info: &'static TechniqueInfo, visibility: vk::Format) -> Result<Box<dyn Technique>> {
     match info.name {
         name if [shadow_map::INFO.name, shadow_map::PCF.name, shadow_map::PCSS.name].contains(&name) => {
-            Ok(Box::new(shadow_map::ShadowMap::new(ctx, info)?))
+            Ok(Box::new(shadow_map::ShadowMap::new(ctx, info, visibility)?))
         }
-        name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx)?)),
-        name if name == plateau::INFO.name => Ok(Box::new(plateau::Plateau::new(ctx)?)),
-        name if name == smoothie::INFO.name => Ok(Box::new(smoothie::Smoothie::new(ctx)?)),
+        name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx, visibility)?)),
+        name if name == plateau::INFO.name => Ok(Box::new(plateau::Plateau::new(ctx, visibility)?)),
+        name if name == smoothie::INFO.name => Ok(Box::new(smoothie::Smoothie::new(ctx, visibility)?)),
         name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
         name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),
         other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),

@@ -133,7 +133,8 @@ pub struct Plateau {
 }
 
 impl Plateau {
-    pub fn new(ctx: &Context) -> Result<Self> {
+    /// `visibility`: the format of the V target the resolve writes.
+    pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
         let vertex = vk::ShaderStageFlags::VERTEX;
         let depth = Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS });
         let umbra = Pipeline::new(
@@ -167,10 +168,9 @@ impl Plateau {
             )?;
             let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
             let bindings = [&b[..], &[Binding::Sampled]].concat();
-            let format = crate::renderer::VISIBILITY_FORMAT;
             let resolve = Pipeline::fullscreen(
                 ctx,
-                &Fullscreen::new("resolve", shaders::PLATEAU_RESOLVE_FRAG, &bindings, format),
+                &Fullscreen::new("resolve", shaders::PLATEAU_RESOLVE_FRAG, &bindings, visibility),
             );
             let resolve = match resolve {
                 Ok(r) => r,

@@ -65,7 +65,8 @@ pub struct Reference {
 }
 
 impl Reference {
-    pub fn new(ctx: &Context) -> Result<Self> {
+    /// `visibility`: the format of the V target the resolve writes.
+    pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
         let depth = depth_pipeline(ctx, vk::Format::R32_SFLOAT)?;
         let sampled = Binding::Sampled;
         let bindings = [Binding::Uniform, Binding::Storage, sampled, sampled, sampled];
@@ -80,10 +81,9 @@ impl Reference {
                 return Err(e);
             }
         };
-        let format = crate::renderer::VISIBILITY_FORMAT;
         match Pipeline::fullscreen(
             ctx,
-            &Fullscreen::new("resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], format),
+            &Fullscreen::new("resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], visibility),
         ) {
             Ok(resolve) => {
                 let reference = Reference {

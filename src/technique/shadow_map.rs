@@ -278,11 +278,14 @@ pub struct ShadowMap {
     pass: ShadowMapPass,
     /// Resolve pipelines made so far, by filter (a `pcf` knob can switch filters).
     resolves: Vec<(Filter, Pipeline)>,
+    /// The V target's format, which the resolves write.
+    visibility: vk::Format,
 }
 
 impl ShadowMap {
-    pub fn new(ctx: &Context, technique: &'static TechniqueInfo) -> Result<Self> {
-        Ok(ShadowMap { technique, pass: ShadowMapPass::new(ctx, vk::Format::R32_SFLOAT)?, resolves: Vec::new() })
+    pub fn new(ctx: &Context, technique: &'static TechniqueInfo, visibility: vk::Format) -> Result<Self> {
+        let pass = ShadowMapPass::new(ctx, vk::Format::R32_SFLOAT)?;
+        Ok(ShadowMap { technique, pass, resolves: Vec::new(), visibility })
     }
 
     /// Index in `resolves` of the pipeline for `filter`, made on first use.
@@ -291,9 +294,9 @@ impl ShadowMap {
             return Ok(i);
         }
         let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
-        let format = crate::renderer::VISIBILITY_FORMAT;
         let constants = [filter as u32];
-        let desc = Fullscreen::new("resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, format).constants(&constants);
+        let desc =
+            Fullscreen::new("resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, self.visibility).constants(&constants);
         self.resolves.push((filter, Pipeline::fullscreen(ctx, &desc)?));
         Ok(self.resolves.len() - 1)
     }

@@ -128,7 +128,8 @@ pub struct Smoothie {
 }
 
 impl Smoothie {
-    pub fn new(ctx: &Context) -> Result<Self> {
+    /// `visibility`: the format of the V target the resolve writes.
+    pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
         let pass = ShadowMapPass::new(ctx, DEPTH_FORMAT)?;
         let pipelines = (|| {
             let smoothie = Pipeline::new(
@@ -150,10 +151,9 @@ impl Smoothie {
             )?;
             let b = [Binding::Uniform, Binding::Uniform];
             let bindings = [&b[..], &[Binding::Sampled; 6]].concat();
-            let format = crate::renderer::VISIBILITY_FORMAT;
             match Pipeline::fullscreen(
                 ctx,
-                &Fullscreen::new("resolve", shaders::SMOOTHIE_RESOLVE_FRAG, &bindings, format),
+                &Fullscreen::new("resolve", shaders::SMOOTHIE_RESOLVE_FRAG, &bindings, visibility),
             ) {
                 Ok(resolve) => Ok((smoothie, resolve)),
                 Err(e) => {

@@ -12,7 +12,7 @@ use super::{FrameInputs, Technique};
 use crate::error::Result;
 use crate::gpu::{Context, FRAMES_IN_FLIGHT, PerFrame, Target, copy_to_target};
 use crate::reference::TraceScene;
-use crate::renderer::Surfaces;
+use crate::renderer::{RAW_VISIBILITY_FORMAT, Surfaces, quantize};
 
 pub const RAYTRACE: TechniqueInfo = TechniqueInfo {
     offline: true,
@@ -85,8 +85,14 @@ impl Technique for Traced {
             bar.finish_and_clear();
         }
 
-        let texels: Vec<u16> = image.visibility.iter().map(|v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16).collect();
-        let bytes: &[u8] = bytemuck::cast_slice(&texels);
+        // Raw visibility keeps the tracer's floats as they are, for the stability checks.
+        let texels: Vec<u16>;
+        let bytes: &[u8] = if visibility.desc.format == RAW_VISIBILITY_FORMAT {
+            bytemuck::cast_slice(&image.visibility)
+        } else {
+            texels = image.visibility.iter().map(|&v| quantize(v)).collect();
+            bytemuck::cast_slice(&texels)
+        };
         if self.staging.as_ref().is_none_or(|s| s.capacity() < bytes.len() as u64) {
             // Grows only; the old buffer may still be read by the frame in flight.
             ctx.wait_idle()?;
