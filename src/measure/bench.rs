@@ -64,7 +64,7 @@ pub fn mark_pareto(rows: &mut [BenchRow]) {
 
 pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
     let mut out = String::from(
-        "scene,technique,setting,gpu_ms_total_median,gpu_ms_total_p95,cpu_ms_median,rmse,mae,max_abs,p99_abs,\
+        "scene,technique,setting,gpu_ms_total_median,gpu_ms_total_p95,cpu_ms_median,cpu_ms_technique,rmse,mae,max_abs,p99_abs,\
          penumbra_rmse,leak_rate,dark_rate,mean_bias,pixels,excluded,pareto,passes\n",
     );
     for r in rows {
@@ -73,13 +73,14 @@ pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
             r.timings.passes.iter().map(|p| format!("{}={:.3}", p.name, p.gpu_ms_median)).collect();
         let _ = writeln!(
             out,
-            "{},{},\"{}\",{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{},{},\"{}\"",
+            "{},{},\"{}\",{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{},{},\"{}\"",
             r.scene,
             r.technique,
             r.setting,
             r.timings.gpu_ms_total_median,
             r.timings.gpu_ms_total_p95,
             r.timings.cpu_ms.get("record").copied().unwrap_or(0.0),
+            r.timings.cpu_ms.get("technique").copied().unwrap_or(0.0),
             m.rmse,
             m.mae,
             m.max_abs,
@@ -109,13 +110,14 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
             t.device, t.driver, t.width, t.height, t.frames
         );
     }
+    out += &summary(rows);
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
     for scene in scenes {
         let mut of_scene: Vec<&BenchRow> = rows.iter().filter(|r| r.scene == scene).collect();
         of_scene.sort_by(|a, b| a.timings.gpu_ms_total_median.total_cmp(&b.timings.gpu_ms_total_median));
         let _ = writeln!(out, "## {scene}\n");
-        out += "| | technique | setting | GPU ms | CPU ms | RMSE | penumbra RMSE | leak | dark |\n";
+        out += "| | technique | setting | GPU ms | technique CPU ms | RMSE | penumbra RMSE | leak | dark |\n";
         out += "|---|---|---|---|---|---|---|---|---|\n";
         for r in of_scene {
             let (t, m) = (&r.timings, &r.metrics);
@@ -127,7 +129,7 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
                 if r.setting.is_empty() { "defaults" } else { &r.setting },
                 t.gpu_ms_total_median,
                 t.gpu_ms_total_p95,
-                t.cpu_ms.get("record").copied().unwrap_or(0.0),
+                t.cpu_ms.get("technique").copied().unwrap_or(0.0),
                 m.rmse,
                 m.penumbra_rmse,
                 m.leak_rate,
@@ -137,6 +139,41 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         out += "\n";
     }
     std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+}
+
+/// Per technique and setting, the medians over the scenes and on how many scenes the row is
+/// Pareto-optimal, sorted by median cost.
+fn summary(rows: &[BenchRow]) -> String {
+    let mut keys: Vec<(&str, &str)> = Vec::new();
+    for r in rows {
+        if !keys.contains(&(r.technique.as_str(), r.setting.as_str())) {
+            keys.push((&r.technique, &r.setting));
+        }
+    }
+    let median = |v: Vec<f64>| super::timings::percentile(&v, 0.5);
+    let mut lines: Vec<(f64, String)> = keys
+        .iter()
+        .map(|&(technique, setting)| {
+            let of: Vec<&BenchRow> = rows.iter().filter(|r| r.technique == technique && r.setting == setting).collect();
+            let ms = median(of.iter().map(|r| r.timings.gpu_ms_total_median).collect());
+            let line = format!(
+                "| {technique} | {} | {ms:.2} | {:.4} | {:.4} | {}/{} |\n",
+                if setting.is_empty() { "defaults" } else { setting },
+                median(of.iter().map(|r| r.metrics.rmse).collect()),
+                median(of.iter().map(|r| r.metrics.penumbra_rmse).collect()),
+                of.iter().filter(|r| r.pareto).count(),
+                of.len()
+            );
+            (ms, line)
+        })
+        .collect();
+    lines.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out = String::from(
+        "## All scenes\n\nMedians over the scenes; the last column counts the scenes where the row is Pareto-optimal.\n\n\
+         | technique | setting | GPU ms | RMSE | penumbra RMSE | Pareto |\n|---|---|---|---|---|---|\n",
+    );
+    lines.into_iter().for_each(|(_, line)| out += &line);
+    out + "\n"
 }
 
 /// Stores a reference capture's visibility and surfaces (the colour is not needed).
