@@ -241,7 +241,8 @@ fn settings(setup: &Setup, info: &'static TechniqueInfo, knobs: &[(&str, &str)])
 }
 
 /// Runs `techniques` (all when empty) over `axis`'s grid on `engine`, which is switched to raw
-/// visibility for the sweep and back afterwards. `progress` hears each render's label.
+/// visibility for the sweep and back afterwards, also when the sweep fails. `progress` hears
+/// each render's label.
 pub fn sweep(
     engine: &mut Engine,
     axis: Axis,
@@ -250,9 +251,22 @@ pub fn sweep(
     progress: &mut dyn FnMut(&str),
 ) -> Result<Vec<ExtremeRow>> {
     let techniques = if techniques.is_empty() { TECHNIQUES } else { techniques };
+    engine.set_raw_visibility(true)?;
+    let rows = sweep_raw(engine, axis, long, techniques, progress);
+    engine.set_raw_visibility(false)?;
+    rows
+}
+
+/// [`sweep`] on an engine already keeping raw visibility.
+fn sweep_raw(
+    engine: &mut Engine,
+    axis: Axis,
+    long: bool,
+    techniques: &[&'static TechniqueInfo],
+    progress: &mut dyn FnMut(&str),
+) -> Result<Vec<ExtremeRow>> {
     let grid = axis.grid(long);
     let scenes: Vec<Scene> = grid.iter().map(Setup::scene).collect::<Result<_>>()?;
-    engine.set_raw_visibility(true)?;
     let mut truths: Vec<Option<Capture>> = Vec::with_capacity(grid.len());
     for (setup, scene) in grid.iter().zip(&scenes) {
         progress(&format!("{} = {}: truth", axis.name(), axis.value(setup)));
@@ -291,7 +305,6 @@ pub fn sweep(
             });
         }
     }
-    engine.set_raw_visibility(false)?;
     Ok(rows)
 }
 
