@@ -459,7 +459,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         return extremes(args);
     }
     use softshadow::measure::bench::{
-        BenchRow, load_reference, mark_pareto, save_reference, sweep, write_csv, write_report,
+        BenchRow, COST_GOALS, load_reference, mark_pareto, save_reference, sweep, write_csv, write_report,
     };
     let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
@@ -552,6 +552,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
+    COST_GOALS.iter().filter_map(|g| g.outcome(&rows)).for_each(|line| println!("{line}"));
     if let (Some(trace), Some(p)) = (&trace, &args.trace) {
         trace.write(p)?;
         println!("wrote {}", p.display());

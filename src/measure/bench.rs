@@ -48,6 +48,110 @@ pub fn sweep(quick: bool) -> Vec<(&'static str, Vec<(&'static str, &'static str)
     runs
 }
 
+/// A cost goal set by the issues: `technique [setting]`'s frame costs at most `max_ratio` times
+/// the `baseline [baseline_setting]` frame, compared per scene within one run.
+#[derive(Clone, Copy, Debug)]
+pub struct CostGoal {
+    pub technique: &'static str,
+    pub setting: &'static str,
+    pub baseline: &'static str,
+    pub baseline_setting: &'static str,
+    pub max_ratio: f64,
+}
+
+/// Plateaus against the hard map at the same screen size (issue 4); smoothies, whose map is
+/// 1024² by default, against the hard map at 1024² (issue 5).
+pub const COST_GOALS: [CostGoal; 2] = [
+    CostGoal { technique: "plateau", setting: "", baseline: "shadow-map", baseline_setting: "", max_ratio: 1.3 },
+    CostGoal {
+        technique: "smoothie",
+        setting: "",
+        baseline: "shadow-map",
+        baseline_setting: "shadow_map_size=1024",
+        max_ratio: 1.3,
+    },
+];
+
+impl CostGoal {
+    /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`.
+    pub fn label(&self) -> String {
+        let side = |t: &str, s: &str| if s.is_empty() { t.to_string() } else { format!("{t} {s}") };
+        format!(
+            "{} / {} ≤ {}",
+            side(self.technique, self.setting),
+            side(self.baseline, self.baseline_setting),
+            self.max_ratio
+        )
+    }
+
+    /// Per scene holding both rows, the ratio of their median GPU ms, in the rows' scene order.
+    pub fn ratios<'a>(&self, rows: &'a [BenchRow]) -> Vec<(&'a str, f64)> {
+        let ms = |scene: &str, technique: &str, setting: &str| {
+            rows.iter()
+                .find(|r| r.scene == scene && r.technique == technique && r.setting == setting)
+                .map(|r| r.timings.gpu_ms_total_median)
+        };
+        scenes(rows)
+            .into_iter()
+            .filter_map(|scene| {
+                let of = ms(scene, self.technique, self.setting)?;
+                let base = ms(scene, self.baseline, self.baseline_setting)?;
+                Some((scene, of / base))
+            })
+            .collect()
+    }
+
+    /// One line for the terminal, e.g. `smoothie / shadow-map … ≤ 1.3: met on 9/10 scenes
+    /// (0.95–1.35)`; `None` when no scene has both rows.
+    pub fn outcome(&self, rows: &[BenchRow]) -> Option<String> {
+        let ratios: Vec<f64> = self.ratios(rows).into_iter().map(|(_, r)| r).collect();
+        let lo = ratios.iter().copied().reduce(f64::min)?;
+        let hi = ratios.iter().copied().reduce(f64::max)?;
+        let met = ratios.iter().filter(|r| **r <= self.max_ratio).count();
+        Some(format!("{}: met on {met}/{} scenes ({lo:.2}–{hi:.2})", self.label(), ratios.len()))
+    }
+}
+
+/// The cost goals as a table, scene by scene, with how many scenes meet each; empty when no
+/// goal has both of its rows in `rows`.
+pub fn cost_goals(rows: &[BenchRow]) -> String {
+    let goals: Vec<(CostGoal, Vec<(&str, f64)>)> =
+        COST_GOALS.iter().map(|g| (*g, g.ratios(rows))).filter(|(_, r)| !r.is_empty()).collect();
+    if goals.is_empty() {
+        return String::new();
+    }
+    let mut out =
+        String::from("## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds.\n\n| scene |");
+    for (g, _) in &goals {
+        let _ = write!(out, " {} |", g.label());
+    }
+    let _ = write!(out, "\n|---|{}\n", "---|".repeat(goals.len()));
+    for scene in scenes(rows) {
+        let _ = write!(out, "| {scene} |");
+        for (g, ratios) in &goals {
+            match ratios.iter().find(|(s, _)| *s == scene) {
+                Some((_, r)) => {
+                    let _ = write!(out, " {r:.2} {} |", if *r <= g.max_ratio { "✓" } else { "✗" });
+                }
+                None => out += " |",
+            }
+        }
+        out += "\n";
+    }
+    out += "| met |";
+    for (g, ratios) in &goals {
+        let _ = write!(out, " {}/{} |", ratios.iter().filter(|(_, r)| *r <= g.max_ratio).count(), ratios.len());
+    }
+    out + "\n\n"
+}
+
+/// The scenes of `rows`, in their order (the sweep keeps each scene's rows together).
+fn scenes(rows: &[BenchRow]) -> Vec<&str> {
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    scenes
+}
+
 /// Marks the rows no other row of the same scene dominates (cheaper and no less accurate, or
 /// more accurate and no dearer).
 pub fn mark_pareto(rows: &mut [BenchRow]) {
@@ -111,9 +215,8 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         );
     }
     out += &summary(rows);
-    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
-    scenes.dedup();
-    for scene in scenes {
+    out += &cost_goals(rows);
+    for scene in scenes(rows) {
         let mut of_scene: Vec<&BenchRow> = rows.iter().filter(|r| r.scene == scene).collect();
         of_scene.sort_by(|a, b| a.timings.gpu_ms_total_median.total_cmp(&b.timings.gpu_ms_total_median));
         let _ = writeln!(out, "## {scene}\n");
@@ -222,4 +325,48 @@ pub fn load_reference(path: &Path, width: u32, height: u32) -> Option<Capture> {
         capture.surfaces.receives.push(p[18] != 0);
     }
     Some(capture)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(scene: &str, technique: &str, setting: &str, ms: f64) -> BenchRow {
+        BenchRow {
+            scene: scene.into(),
+            technique: technique.into(),
+            setting: setting.into(),
+            timings: TimingReport { gpu_ms_total_median: ms, ..Default::default() },
+            metrics: Metrics::default(),
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn cost_goals_compare_each_scene_with_its_own_baseline() {
+        let rows = [
+            row("a", "shadow-map", "", 10.0),
+            row("a", "shadow-map", "shadow_map_size=1024", 5.0),
+            row("a", "smoothie", "", 6.0),
+            row("a", "smoothie", "depth16=1", 1.0),
+            row("b", "shadow-map", "shadow_map_size=1024", 4.0),
+            row("b", "smoothie", "", 6.0),
+            row("c", "smoothie", "", 1.0),
+        ];
+        let smoothie = COST_GOALS[1];
+        // Scene c has no baseline row, so it has no ratio rather than a made-up one.
+        assert_eq!(smoothie.ratios(&rows), vec![("a", 1.2), ("b", 1.5)]);
+        assert_eq!(
+            smoothie.outcome(&rows).unwrap(),
+            "smoothie / shadow-map shadow_map_size=1024 ≤ 1.3: met on 1/2 scenes (1.20–1.50)"
+        );
+        // No plateau rows: that goal is left out of the table, not shown as failed.
+        assert_eq!(COST_GOALS[0].outcome(&rows), None);
+        let table = cost_goals(&rows);
+        assert!(!table.contains("plateau"), "{table}");
+        for line in ["| a | 1.20 ✓ |", "| b | 1.50 ✗ |", "| c | |", "| met | 1/2 |"] {
+            assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
+        }
+        assert_eq!(cost_goals(&rows[..1]), "");
+    }
 }

@@ -16,7 +16,7 @@ pub struct PassSummary {
 }
 
 /// What `--timings FILE` writes.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct TimingReport {
     pub device: String,
     pub driver: String,
