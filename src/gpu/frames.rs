@@ -21,6 +21,8 @@ pub struct FrameRing {
     pool: vk::CommandPool,
     slots: Vec<Slot>,
     next: usize,
+    /// The raw GPU timestamp that pass begin times count from.
+    gpu_origin: Option<u64>,
 }
 
 /// A frame being recorded.
@@ -37,7 +39,7 @@ impl FrameRing {
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
-        let mut ring = FrameRing { pool, slots: Vec::new(), next: 0 };
+        let mut ring = FrameRing { pool, slots: Vec::new(), next: 0, gpu_origin: None };
         if let Err(e) = ring.fill(ctx) {
             ring.destroy(ctx);
             return Err(e);
@@ -111,7 +113,7 @@ impl FrameRing {
             tick();
         }
         unsafe { ctx.device.wait_for_fences(&[s.fence], true, 0) }.vk("vkWaitForFences")?;
-        s.timer.collect(ctx)
+        s.timer.collect(ctx, &mut self.gpu_origin)
     }
 
     /// Waits for every frame in flight; returns their pass times, oldest first.

@@ -14,7 +14,8 @@ const MAX_PASSES: u32 = 32;
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
     pub name: &'static str,
-    /// When the pass began on the GPU's clock (arbitrary origin; only differences mean anything).
+    /// When the pass began on the GPU's clock, since the first pass its frame ring timed (only
+    /// differences mean anything).
     pub begin_ms: f64,
     pub ms: f64,
 }
@@ -73,8 +74,10 @@ impl PassTimer {
     }
 
     /// The submitted frame's pass times; call only after its fence signalled. `None` when no
-    /// frame was submitted since the last call.
-    pub fn collect(&mut self, ctx: &Context) -> Result<Option<Vec<PassTime>>> {
+    /// frame was submitted since the last call. `origin` is the raw timestamp that begin times
+    /// count from, set by the first call: raw values can be so large (on an H100's driver) that
+    /// an f64 of milliseconds since the counter's own zero blurs them by tenths of a microsecond.
+    pub fn collect(&mut self, ctx: &Context, origin: &mut Option<u64>) -> Result<Option<Vec<PassTime>>> {
         if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
             return Ok(None);
         }
@@ -83,15 +86,16 @@ impl PassTimer {
             .vk("vkGetQueryPoolResults")?;
         let bits = ctx.info.timestamp_valid_bits;
         let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
-        let period = ctx.info.timestamp_period_ns as f64;
+        let ms = ctx.info.timestamp_period_ns as f64 * 1e-6;
+        let origin = *origin.get_or_insert(raw[0] & mask);
         Ok(Some(
             self.names
                 .iter()
                 .zip(raw.chunks_exact(2))
                 .map(|(&name, t)| PassTime {
                     name,
-                    begin_ms: (t[0] & mask) as f64 * period * 1e-6,
-                    ms: ((t[1] & mask).wrapping_sub(t[0] & mask) & mask) as f64 * period * 1e-6,
+                    begin_ms: ticks_since(t[0], origin, mask) * ms,
+                    ms: ticks_since(t[1], t[0], mask) * ms,
                 })
                 .collect(),
         ))
@@ -100,6 +104,13 @@ impl PassTimer {
     pub fn destroy(self, ctx: &Context) {
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
     }
+}
+
+/// Ticks from `origin` to `t` on a counter of `mask`'s valid bits that wraps around; a
+/// difference of half the range or more means `t` came first.
+fn ticks_since(t: u64, origin: u64, mask: u64) -> f64 {
+    let ahead = t.wrapping_sub(origin) & mask;
+    if ahead > mask / 2 { -((origin.wrapping_sub(t) & mask) as f64) } else { ahead as f64 }
 }
 
 /// Milestones of one long frame (a batch done, a batch done, ...): timestamps written as the
@@ -153,5 +164,22 @@ impl Milestones {
 
     pub fn destroy(self, ctx: &Context) {
         unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ticks_since;
+
+    #[test]
+    fn ticks_keep_nanoseconds_at_any_clock_origin_and_across_wraparound() {
+        // A nanosecond counter read about 57 years after its zero.
+        let now = 1_795_000_000_123_456_789u64;
+        assert_eq!(ticks_since(now + 7, now, u64::MAX), 7.0);
+        assert_eq!(ticks_since(now, now + 7, u64::MAX), -7.0);
+        // A 36-bit counter that wrapped between the two reads.
+        let mask = (1u64 << 36) - 1;
+        assert_eq!(ticks_since(3, mask - 4, mask), 8.0);
+        assert_eq!(ticks_since(mask - 4, 3, mask), -8.0);
     }
 }
