@@ -19,9 +19,9 @@
 //! ```
 
 pub mod error;
+pub mod frame;
 pub mod geometry;
 pub mod gpu;
-mod gpu_types;
 pub mod measure;
 pub mod reference;
 pub mod renderer;

@@ -57,7 +57,7 @@ fn raw_visibility_quantizes_to_the_r16_image() {
         let floats = raw.raw_visibility.as_ref().expect("raw V");
         assert!(floats.iter().any(|&v| v > 0.0 && v < 1.0), "{technique}: a penumbra");
         for (i, (&r16, &v)) in stored.visibility.iter().zip(floats).enumerate() {
-            let q = softshadow::renderer::quantize(v);
+            let q = softshadow::frame::quantize(v);
             assert!(r16.abs_diff(q) <= 1, "{technique} pixel {i}: R16 {r16}, raw {v} quantizes to {q}");
         }
     }

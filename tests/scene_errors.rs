@@ -2,6 +2,7 @@
 
 use std::io::Write;
 
+use softshadow::FrameSettings;
 use softshadow::scene::Scene;
 
 const GOOD: &str = r#"
@@ -23,9 +24,11 @@ size = [1.0, 1.0, 1.0]
 position = [0.0, 0.5, 0.0]
 "#;
 
-/// Loads `text` as `bad.toml`, expects an error, and checks it names the file and each `needle`.
+/// Loads `text` as `bad.toml` and builds its frame settings (which check the technique and its
+/// knobs), expects an error, and checks it names the file and each `needle`.
 fn rejects(text: &str, needles: &[&str]) {
-    let err = Scene::from_toml(text, "bad.toml").expect_err("the scene should be rejected").to_string();
+    let settings = Scene::from_toml(text, "bad.toml").and_then(|s| FrameSettings::from_scene(&s));
+    let err = settings.expect_err("the scene should be rejected").to_string();
     assert!(err.starts_with("bad.toml:"), "error does not name the file: {err}");
     for n in needles {
         assert!(err.contains(n), "error does not mention `{n}`: {err}");
@@ -84,9 +87,18 @@ fn the_light_must_be_above_the_ground() {
 fn render_settings_are_checked() {
     rejects(&format!("{GOOD}\n[render]\nwidth = 0"), &["render size"]);
     rejects(&format!("{GOOD}\n[render]\nwidth = -5"), &["width"]);
-    rejects(&format!("{GOOD}\n[render]\ntechnique = \"shadowmap\""), &["unknown technique", "shadowmap"]);
-    rejects(&format!("{GOOD}\n[render]\n[render.params]\nsamples = 4"), &["samples", "shadow_map_size"]);
-    rejects(&format!("{GOOD}\n[render]\n[render.params]\nshadow_map_size = 3.5"), &["shadow_map_size", "whole number"]);
+    // The technique and each knob are reported at their line: GOOD's lines, a blank one, `[render]`.
+    let technique_line = format!("line {}:", GOOD.lines().count() + 3);
+    let knob_line = format!("line {}:", GOOD.lines().count() + 4);
+    rejects(
+        &format!("{GOOD}\n[render]\ntechnique = \"shadowmap\""),
+        &["unknown technique", "shadowmap", &technique_line],
+    );
+    rejects(&format!("{GOOD}\n[render]\n[render.params]\nsamples = 4"), &["samples", "shadow_map_size", &knob_line]);
+    rejects(
+        &format!("{GOOD}\n[render]\n[render.params]\nshadow_map_size = 3.5"),
+        &["shadow_map_size", "whole number", &knob_line],
+    );
 }
 
 #[test]

@@ -12,8 +12,8 @@ vec3 world_position(mat4 inv_view_proj, vec2 uv, float depth) {
     return world.xyz / world.w;
 }
 
-// The normal target's alpha: how the surface takes part in shadowing (see `shadow_role` in
-// src/renderer/mod.rs): 0 receives no shadow, 0.5 receives, 1 receives and casts.
+// The normal target's alpha: how the surface takes part in shadowing (see `ShadowRole` in
+// src/frame/mod.rs): 0 receives no shadow, 0.5 receives, 1 receives and casts.
 struct Surface {
     vec3 p;        // world position
     vec3 n;        // the facet's unit normal, on the side facing the camera

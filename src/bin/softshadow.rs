@@ -7,7 +7,8 @@ use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::{Metrics, TimingReport, Trace, save_difference};
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, TECHNIQUES, TechniqueInfo, knobs, reference, traced};
+use softshadow::technique::registry::{Runs, ground_truth};
+use softshadow::technique::{Kind, Params, TECHNIQUES, TechniqueInfo, find};
 use softshadow::{Capture, Engine, FrameSettings};
 
 /// Frames rendered before timing starts (pipelines warm, caches filled).
@@ -81,9 +82,9 @@ struct RenderArgs {
 struct CompareArgs {
     #[command(flatten)]
     what: SceneArgs,
-    /// The ground truth: `reference` (GPU) or `raytrace` (CPU).
-    #[arg(long, default_value = "reference")]
-    against: String,
+    /// A ground truth (`softshadow techniques` lists them) [default: the one on the GPU].
+    #[arg(long)]
+    against: Option<String>,
     /// A knob of the ground truth, KEY=VALUE; repeatable.
     #[arg(long = "against-set", value_name = "KEY=VALUE")]
     against_set: Vec<String>,
@@ -189,7 +190,7 @@ fn showcase(args: &ShowcaseArgs) -> Result<()> {
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
     let bar = indicatif::ProgressBar::new(TECHNIQUES.len() as u64);
-    let truth_info = &traced::RAYTRACE;
+    let truth_info = ground_truth(Runs::Cpu);
     bar.set_message(truth_info.name);
     let truth_settings = FrameSettings { params: Params::defaults(truth_info), ..base.clone() };
     let truth = render_frames(&mut engine, &scene, &truth_settings, None, None)?;
@@ -221,7 +222,7 @@ fn showcase(args: &ShowcaseArgs) -> Result<()> {
         .map(|(info, capture, report, metrics)| Tile {
             title: info.name.to_string(),
             // Short enough for 256-pixel tiles; the CPU tracers' cost is their CPU time.
-            detail: match (metrics, info.offline && cpu(report) > report.gpu_ms_total_median) {
+            detail: match (metrics, info.kind.offline() && cpu(report) > report.gpu_ms_total_median) {
                 (Some(m), true) => format!("CPU {:.0} ms  RMSE {:.4}", cpu(report), m.rmse),
                 (Some(m), false) => format!("GPU {:.1} ms  RMSE {:.4}", report.gpu_ms_total_median, m.rmse),
                 (None, _) => format!("truth, CPU {:.0} ms", cpu(report)),
@@ -281,7 +282,7 @@ fn apply_sets(params: &mut Params, pairs: &[String]) -> Result<()> {
 fn load(args: &SceneArgs) -> Result<(Scene, FrameSettings)> {
     let mut scene = Scene::load(&args.scene)?;
     if let Some(t) = &args.technique {
-        knobs::find(t)?;
+        find(t)?;
         // A different technique starts from its own defaults, not the scene's knobs.
         if *t != scene.render.technique {
             scene.render.params.clear();
@@ -305,7 +306,7 @@ fn render_frames(
     frames: Option<usize>,
     trace: Option<(&mut Trace, &serde_json::Value)>,
 ) -> Result<(Capture, TimingReport)> {
-    let offline = settings.params.technique.offline;
+    let offline = settings.params.technique.kind.offline();
     let frames = frames.unwrap_or(if offline { 1 } else { 20 });
     if frames == 0 {
         bail!("--frames must be at least 1");
@@ -369,9 +370,11 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
 /// `compare`: the technique's metrics against a ground truth on the same camera pixels.
 fn compare(args: &CompareArgs) -> Result<()> {
     let (scene, settings) = load(&args.what)?;
-    let against = knobs::find(&args.against)?;
-    if ![reference::INFO.name, traced::RAYTRACE.name].contains(&against.name) {
-        bail!("--against takes a ground truth (reference or raytrace), not `{}`", against.name);
+    let against = args.against.as_deref().map_or(Ok(ground_truth(Runs::Gpu)), find)?;
+    if !matches!(against.kind, Kind::GroundTruth(_)) {
+        let truths: Vec<_> =
+            TECHNIQUES.iter().filter(|t| matches!(t.kind, Kind::GroundTruth(_))).map(|t| t.name).collect();
+        bail!("--against takes a ground truth ({}), not `{}`", truths.join(" or "), against.name);
     }
     let mut truth = FrameSettings { params: Params::defaults(against), ..settings.clone() };
     apply_sets(&mut truth.params, &args.against_set)?;
@@ -432,7 +435,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
 /// `bench --extremes`: the long grids of measure::extremes.
 fn extremes(args: &BenchArgs) -> Result<()> {
     use softshadow::measure::extremes::{Axis, problems, sweep, write_csv};
-    let techniques = args.techniques.iter().map(|t| knobs::find(t)).collect::<Result<Vec<_>, _>>()?;
+    let techniques = args.techniques.iter().map(|t| find(t)).collect::<Result<Vec<_>, _>>()?;
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
     let bar = indicatif::ProgressBar::new_spinner();
@@ -459,7 +462,8 @@ fn bench(args: &BenchArgs) -> Result<()> {
         return extremes(args);
     }
     use softshadow::measure::bench::{
-        BenchRow, COST_GOALS, load_reference, mark_pareto, save_reference, sweep, write_csv, write_report,
+        BenchRow, load_reference, mark_pareto, registry_cost_goals, save_reference, setting_label, sweep, write_csv,
+        write_report,
     };
     let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
@@ -476,11 +480,11 @@ fn bench(args: &BenchArgs) -> Result<()> {
         all
     };
     for t in &args.techniques {
-        knobs::find(t)?;
+        find(t)?;
     }
     let runs: Vec<_> = sweep(args.quick)
         .into_iter()
-        .filter(|(t, _)| args.techniques.is_empty() || args.techniques.iter().any(|n| n == t))
+        .filter(|(t, _)| args.techniques.is_empty() || args.techniques.iter().any(|n| n == t.name))
         .collect();
     let size = if args.quick { 128 } else { 512 };
     let cache = args.out.join("cache");
@@ -493,7 +497,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         let name = path.file_stem().map_or_else(|| path.display().to_string(), |s| s.to_string_lossy().into_owned());
         let what = SceneArgs {
             scene: path.clone(),
-            technique: Some("reference".into()),
+            technique: Some(ground_truth(Runs::Gpu).name.into()),
             set: vec![format!("samples={}", args.reference_samples)],
             width: Some(size),
             height: Some(size),
@@ -519,12 +523,12 @@ fn bench(args: &BenchArgs) -> Result<()> {
             }
         };
         bar.inc(1);
-        for (technique, sets) in &runs {
+        for &(info, sets) in &runs {
+            let technique = info.name;
             bar.set_message(format!("{name}: {technique}"));
-            let mut settings =
-                FrameSettings { params: Params::defaults(knobs::find(technique)?), ..truth_settings.clone() };
+            let mut settings = FrameSettings { params: Params::defaults(info), ..truth_settings.clone() };
             settings.params.apply(sets.iter().copied())?;
-            let setting = sets.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ");
+            let setting = setting_label(sets);
             let label = serde_json::json!({"scene": name, "technique": technique, "setting": setting});
             let started = std::time::Instant::now();
             let (capture, timings) =
@@ -548,11 +552,11 @@ fn bench(args: &BenchArgs) -> Result<()> {
     bar.finish_and_clear();
     finish(engine)?;
     mark_pareto(&mut rows);
-    let reference = format!("reference (samples={})", args.reference_samples);
+    let reference = format!("{} (samples={})", ground_truth(Runs::Gpu).name, args.reference_samples);
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
-    COST_GOALS.iter().filter_map(|g| g.outcome(&rows)).for_each(|line| println!("{line}"));
+    registry_cost_goals().iter().filter_map(|g| g.outcome(&rows)).for_each(|line| println!("{line}"));
     if let (Some(trace), Some(p)) = (&trace, &args.trace) {
         trace.write(p)?;
         println!("wrote {}", p.display());

@@ -1,15 +1,18 @@
-//! Pure math, no Vulkan: bounds, projections, convex clipping, light-frustum fitting and light
+//! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting and light
 //! sampling.
 
+pub mod adjacency;
 mod bounds;
 mod clip;
 mod light_frustum;
 mod light_samples;
 pub mod plateau;
 mod projection;
+pub mod shapes;
 pub mod silhouette;
 pub mod smoothie;
 
+pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
 pub use bounds::Aabb;
 pub use clip::{Hexahedron, intersection_points};
 pub use light_frustum::{LightFrustum, fit_spot_frustum};

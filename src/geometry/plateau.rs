@@ -312,6 +312,7 @@ pub fn plateau_sides(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::EdgeAdjacency;
     use proptest::prelude::*;
 
     fn circle(x: f32, y: f32, r: f32) -> Cone {
@@ -389,11 +390,12 @@ mod tests {
 
         #[test]
         fn silhouettes_of_a_closed_mesh_form_closed_loops(l in (-6.0f32..6.0, 2.0f32..12.0, -6.0f32..6.0)) {
-            let mesh = crate::scene::primitives::sphere(1.0).unwrap();
+            let (sphere, triangles) = crate::geometry::shapes::sphere(1.0);
+            let adjacency = EdgeAdjacency::build(&triangles);
             // A light outside the sphere (centre (0, 1.5, 0), radius 1) sees a silhouette.
             prop_assume!((Vec3::from(l) - Vec3::Y * 1.5).length() > 1.1);
-            let positions: Vec<Vec3> = mesh.positions.iter().map(|p| *p + Vec3::Y * 1.5).collect();
-            let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let positions: Vec<Vec3> = sphere.iter().map(|p| *p + Vec3::Y * 1.5).collect();
+            let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
             let facing = light_facing(&caster, Vec3::from(l));
             let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
             prop_assert!(!edges.is_empty());
@@ -409,9 +411,10 @@ mod tests {
 
     #[test]
     fn the_mailbox_draws_each_cone_once() {
-        let mesh = crate::scene::primitives::cuboid(Vec3::ONE).unwrap();
-        let positions: Vec<Vec3> = mesh.positions.iter().map(|p| *p + Vec3::new(0.0, 2.0, 0.0)).collect();
-        let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let (cube, triangles) = crate::geometry::shapes::cuboid(Vec3::ONE);
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let positions: Vec<Vec3> = cube.iter().map(|p| *p + Vec3::new(0.0, 2.0, 0.0)).collect();
+        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
         let light = PlateauLight {
             position: Vec3::new(2.0, 8.0, 1.0),
             radius: 0.5,

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use crate::scene::{EdgeAdjacency, NO_FACE};
+use super::adjacency::{EdgeAdjacency, NO_FACE};
 
 /// A caster as silhouette extraction sees it.
 pub struct Caster<'a> {

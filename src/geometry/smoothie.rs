@@ -145,12 +145,14 @@ pub fn smoothies(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::EdgeAdjacency;
     use proptest::prelude::*;
 
-    fn plate(height: f32) -> (Vec<Vec3>, crate::scene::Mesh) {
-        let mesh = crate::scene::primitives::cuboid(Vec3::new(1.0, 0.0, 1.0)).unwrap();
-        let positions = mesh.positions.iter().map(|p| *p + Vec3::Y * height).collect();
-        (positions, mesh)
+    /// A unit plate at `height`: positions, triangles and their adjacency.
+    fn plate(height: f32) -> (Vec<Vec3>, Vec<[u32; 3]>, EdgeAdjacency) {
+        let (positions, triangles) = crate::geometry::shapes::cuboid(Vec3::new(1.0, 0.0, 1.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        (positions.iter().map(|p| *p + Vec3::Y * height).collect(), triangles, adjacency)
     }
 
     /// Looking straight down from (0, 10, 0): tangent x = world x / depth, y = world z / depth.
@@ -162,8 +164,8 @@ mod tests {
     proptest! {
         #[test]
         fn edges_extend_outward_by_t_and_corners_are_radial(height in 0.5f32..5.0, t in 0.001f32..0.5) {
-            let (positions, mesh) = plate(height);
-            let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let (positions, triangles, adjacency) = plate(height);
+            let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
             let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
             prop_assert_eq!(edges.len(), 4, "a plate under the light: its outline");
             let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), &mut Mailbox::default(), 1);
@@ -193,8 +195,8 @@ mod tests {
 
     #[test]
     fn vertices_behind_the_light_and_point_edges_are_skipped() {
-        let (positions, mesh) = plate(12.0); // above the light at y = 10
-        let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let (positions, triangles, adjacency) = plate(12.0); // above the light at y = 10
+        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
         let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
         let g =
             smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(0.1), f32::INFINITY), &mut Mailbox::default(), 1);

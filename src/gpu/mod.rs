@@ -18,7 +18,9 @@ pub use context::{Context, ContextOptions, DeviceInfo};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
 pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Binding, Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, VertexInput};
-pub use render::{Attachment, RenderPass, dispatch, draw_indirect, draw_vertices, fullscreen, update_buffer};
+pub use render::{
+    Attachment, RenderPass, dispatch, draw_indexed, draw_indirect, draw_vertices, fullscreen, update_buffer,
+};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{copy_to_target, upload};

@@ -38,12 +38,29 @@ pub enum Descriptor<'a> {
 pub enum VertexInput {
     /// Generated in the shader (full-screen triangle).
     None,
-    /// `Vertex` with only its position read (location 0).
-    Position,
-    /// `Vertex`: position (location 0) and normal (location 1).
-    PositionNormal,
+    /// Vertices of `stride` bytes; location i reads `attributes[i] = (offset, floats)`: 1 to 3
+    /// floats at that byte offset.
+    Interleaved { stride: u32, attributes: &'static [(u32, u32)] },
     /// Generated geometry: tightly packed floats, location i taking `floats[i]` of them.
     Floats(&'static [u32]),
+}
+
+impl VertexInput {
+    /// The stride and the (byte offset, floats) of each location.
+    fn layout(self) -> (u32, Vec<(u32, u32)>) {
+        match self {
+            VertexInput::None => (0, Vec::new()),
+            VertexInput::Interleaved { stride, attributes } => (stride, attributes.to_vec()),
+            VertexInput::Floats(floats) => {
+                let offsets = floats.iter().scan(0, |offset, &n| {
+                    let at = *offset;
+                    *offset += 4 * n;
+                    Some((at, n))
+                });
+                (4 * floats.iter().sum::<u32>(), offsets.collect())
+            }
+        }
+    }
 }
 
 /// Depth test and write of a pipeline.
@@ -238,49 +255,25 @@ impl Pipeline {
                 .name(c"main")
                 .specialization_info(&specialization),
         ];
-        let stride = std::mem::size_of::<crate::scene::Vertex>() as u32;
+        let (stride, attributes) = desc.vertex_input.layout();
         let vb = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
-        let attrs = [
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 12,
-            },
-        ];
-        let floats = if let VertexInput::Floats(f) = desc.vertex_input { f } else { &[] };
-        let mut packed_attrs = Vec::new();
-        let mut offset = 0;
-        for (location, &n) in floats.iter().enumerate() {
-            let format = [vk::Format::R32_SFLOAT, vk::Format::R32G32_SFLOAT, vk::Format::R32G32B32_SFLOAT]
-                [(n as usize).clamp(1, 3) - 1];
-            packed_attrs.push(vk::VertexInputAttributeDescription {
+        let attrs: Vec<_> = attributes
+            .iter()
+            .enumerate()
+            .map(|(location, &(offset, floats))| vk::VertexInputAttributeDescription {
                 location: location as u32,
                 binding: 0,
-                format,
+                format: [vk::Format::R32_SFLOAT, vk::Format::R32G32_SFLOAT, vk::Format::R32G32B32_SFLOAT]
+                    [(floats as usize).clamp(1, 3) - 1],
                 offset,
-            });
-            offset += 4 * n;
-        }
-        let packed =
-            [vk::VertexInputBindingDescription { binding: 0, stride: offset, input_rate: vk::VertexInputRate::VERTEX }];
-        let vertex_input = match desc.vertex_input {
-            VertexInput::Floats(_) => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&packed)
-                .vertex_attribute_descriptions(&packed_attrs),
-            VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
-            VertexInput::Position => vk::PipelineVertexInputStateCreateInfo::default()
+            })
+            .collect();
+        let vertex_input = if attrs.is_empty() {
+            vk::PipelineVertexInputStateCreateInfo::default()
+        } else {
+            vk::PipelineVertexInputStateCreateInfo::default()
                 .vertex_binding_descriptions(&vb)
-                .vertex_attribute_descriptions(&attrs[..1]),
-            VertexInput::PositionNormal => vk::PipelineVertexInputStateCreateInfo::default()
-                .vertex_binding_descriptions(&vb)
-                .vertex_attribute_descriptions(&attrs),
+                .vertex_attribute_descriptions(&attrs)
         };
         let assembly =
             vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);

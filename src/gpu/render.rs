@@ -126,6 +126,23 @@ pub fn draw_vertices(
     }
 }
 
+/// Draws `index_count` indices of `indices` (u32) into `vertices` as instance `instance` (a
+/// mesh; the instance indexes per-object data), with the bound pipeline.
+pub fn draw_indexed(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    vertices: vk::Buffer,
+    indices: vk::Buffer,
+    index_count: u32,
+    instance: u32,
+) {
+    unsafe {
+        ctx.device.cmd_bind_vertex_buffers(cmd, 0, &[vertices], &[0]);
+        ctx.device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
+        ctx.device.cmd_draw_indexed(cmd, index_count, 1, 0, 0, instance);
+    }
+}
+
 /// Draws the vertices of `vertices` as many as the `VkDrawIndirectCommand` at `args` says
 /// (geometry a compute shader generated), with the bound pipeline.
 pub fn draw_indirect(

@@ -6,8 +6,11 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::{Error, Result};
+use crate::frame::Surfaces;
 use crate::measure::{Metrics, TimingReport};
-use crate::renderer::{Capture, Surfaces};
+use crate::renderer::Capture;
+use crate::technique::registry::Setting;
+use crate::technique::{TECHNIQUES, TechniqueInfo};
 
 /// One scene × technique × setting.
 #[derive(Clone, Debug)]
@@ -22,55 +25,47 @@ pub struct BenchRow {
     pub pareto: bool,
 }
 
-/// The settings swept per technique: the knobs that trade speed for accuracy.
-pub fn sweep(quick: bool) -> Vec<(&'static str, Vec<(&'static str, &'static str)>)> {
-    let mut runs = vec![
-        ("shadow-map", vec![]),
-        ("pcf", vec![("taps", "16")]),
-        ("pcss", vec![]),
-        ("plateau", vec![]),
-        ("smoothie", vec![]),
-    ];
-    if !quick {
-        runs.extend([
-            ("shadow-map", vec![("shadow_map_size", "1024")]),
-            ("pcf", vec![("taps", "4")]),
-            ("pcf", vec![("taps", "32")]),
-            ("pcf", vec![("bicubic", "1")]),
-            ("pcss", vec![("blocker_samples", "32"), ("filter_samples", "32")]),
-            ("plateau", vec![("falloff", "1")]),
-            ("plateau", vec![("texture_size", "512")]),
-            ("smoothie", vec![("t_scale", "1")]),
-            ("smoothie", vec![("depth16", "1")]),
-            ("smoothie", vec![("gpu_silhouettes", "1")]),
-        ]);
-    }
-    runs
+/// The settings swept, from each technique's registry entry: every benched technique's first
+/// setting, then (without `quick`) the rest, so the quick sweep is a prefix of the full one.
+pub fn sweep(quick: bool) -> Vec<(&'static TechniqueInfo, Setting)> {
+    let first = TECHNIQUES.iter().filter_map(|t| t.bench.first().map(|s| (*t, *s)));
+    let rest = TECHNIQUES.iter().flat_map(|t| t.bench.iter().skip(1).map(move |s| (*t, *s)));
+    if quick { first.collect() } else { first.chain(rest).collect() }
 }
 
-/// A cost goal set by the issues: `technique [setting]`'s frame costs at most `max_ratio` times
-/// the `baseline [baseline_setting]` frame, compared per scene within one run.
-#[derive(Clone, Copy, Debug)]
+/// `key=value` pairs separated by spaces, as [`BenchRow::setting`] holds them.
+pub fn setting_label(setting: Setting) -> String {
+    setting.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
+}
+
+/// A cost goal from a technique's registry entry, as bench rows name it: `technique
+/// [setting]`'s frame costs at most `max_ratio` times the `baseline [baseline_setting]` frame,
+/// compared per scene within one run.
+#[derive(Clone, Debug)]
 pub struct CostGoal {
     pub technique: &'static str,
-    pub setting: &'static str,
+    pub setting: String,
     pub baseline: &'static str,
-    pub baseline_setting: &'static str,
+    pub baseline_setting: String,
     pub max_ratio: f64,
 }
 
-/// Plateaus against the hard map at the same screen size (issue 4); smoothies, whose map is
-/// 1024² by default, against the hard map at 1024² (issue 5).
-pub const COST_GOALS: [CostGoal; 2] = [
-    CostGoal { technique: "plateau", setting: "", baseline: "shadow-map", baseline_setting: "", max_ratio: 1.3 },
-    CostGoal {
-        technique: "smoothie",
-        setting: "",
-        baseline: "shadow-map",
-        baseline_setting: "shadow_map_size=1024",
-        max_ratio: 1.3,
-    },
-];
+/// Every technique's cost goal, in registry order.
+pub fn registry_cost_goals() -> Vec<CostGoal> {
+    TECHNIQUES
+        .iter()
+        .filter_map(|t| {
+            let g = t.cost_goal?;
+            Some(CostGoal {
+                technique: t.name,
+                setting: setting_label(g.setting),
+                baseline: g.baseline.name,
+                baseline_setting: setting_label(g.baseline_setting),
+                max_ratio: g.max_ratio,
+            })
+        })
+        .collect()
+}
 
 impl CostGoal {
     /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`.
@@ -78,8 +73,8 @@ impl CostGoal {
         let side = |t: &str, s: &str| if s.is_empty() { t.to_string() } else { format!("{t} {s}") };
         format!(
             "{} / {} ≤ {}",
-            side(self.technique, self.setting),
-            side(self.baseline, self.baseline_setting),
+            side(self.technique, &self.setting),
+            side(self.baseline, &self.baseline_setting),
             self.max_ratio
         )
     }
@@ -94,8 +89,8 @@ impl CostGoal {
         scenes(rows)
             .into_iter()
             .filter_map(|scene| {
-                let of = ms(scene, self.technique, self.setting)?;
-                let base = ms(scene, self.baseline, self.baseline_setting)?;
+                let of = ms(scene, self.technique, &self.setting)?;
+                let base = ms(scene, self.baseline, &self.baseline_setting)?;
                 Some((scene, of / base))
             })
             .collect()
@@ -114,9 +109,15 @@ impl CostGoal {
 
 /// The cost goals as a table, scene by scene, with how many scenes meet each; empty when no
 /// goal has both of its rows in `rows`.
-pub fn cost_goals(rows: &[BenchRow]) -> String {
-    let goals: Vec<(CostGoal, Vec<(&str, f64)>)> =
-        COST_GOALS.iter().map(|g| (*g, g.ratios(rows))).filter(|(_, r)| !r.is_empty()).collect();
+pub fn cost_goal_table(goals: Vec<CostGoal>, rows: &[BenchRow]) -> String {
+    let goals: Vec<(CostGoal, Vec<(&str, f64)>)> = goals
+        .into_iter()
+        .map(|g| {
+            let r = g.ratios(rows);
+            (g, r)
+        })
+        .filter(|(_, r)| !r.is_empty())
+        .collect();
     if goals.is_empty() {
         return String::new();
     }
@@ -215,7 +216,7 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         );
     }
     out += &summary(rows);
-    out += &cost_goals(rows);
+    out += &cost_goal_table(registry_cost_goals(), rows);
     for scene in scenes(rows) {
         let mut of_scene: Vec<&BenchRow> = rows.iter().filter(|r| r.scene == scene).collect();
         of_scene.sort_by(|a, b| a.timings.gpu_ms_total_median.total_cmp(&b.timings.gpu_ms_total_median));
@@ -345,28 +346,32 @@ mod tests {
     #[test]
     fn cost_goals_compare_each_scene_with_its_own_baseline() {
         let rows = [
-            row("a", "shadow-map", "", 10.0),
-            row("a", "shadow-map", "shadow_map_size=1024", 5.0),
-            row("a", "smoothie", "", 6.0),
-            row("a", "smoothie", "depth16=1", 1.0),
-            row("b", "shadow-map", "shadow_map_size=1024", 4.0),
-            row("b", "smoothie", "", 6.0),
-            row("c", "smoothie", "", 1.0),
+            row("a", "base", "", 10.0),
+            row("a", "base", "size=1024", 5.0),
+            row("a", "soft", "", 6.0),
+            row("a", "soft", "bits=16", 1.0),
+            row("b", "base", "size=1024", 4.0),
+            row("b", "soft", "", 6.0),
+            row("c", "soft", "", 1.0),
         ];
-        let smoothie = COST_GOALS[1];
+        let goal = |technique| CostGoal {
+            technique,
+            setting: String::new(),
+            baseline: "base",
+            baseline_setting: "size=1024".into(),
+            max_ratio: 1.3,
+        };
+        let soft = goal("soft");
         // Scene c has no baseline row, so it has no ratio rather than a made-up one.
-        assert_eq!(smoothie.ratios(&rows), vec![("a", 1.2), ("b", 1.5)]);
-        assert_eq!(
-            smoothie.outcome(&rows).unwrap(),
-            "smoothie / shadow-map shadow_map_size=1024 ≤ 1.3: met on 1/2 scenes (1.20–1.50)"
-        );
-        // No plateau rows: that goal is left out of the table, not shown as failed.
-        assert_eq!(COST_GOALS[0].outcome(&rows), None);
-        let table = cost_goals(&rows);
-        assert!(!table.contains("plateau"), "{table}");
+        assert_eq!(soft.ratios(&rows), vec![("a", 1.2), ("b", 1.5)]);
+        assert_eq!(soft.outcome(&rows).unwrap(), "soft / base size=1024 ≤ 1.3: met on 1/2 scenes (1.20–1.50)");
+        // No rows of `other`: that goal is left out of the table, not shown as failed.
+        assert_eq!(goal("other").outcome(&rows), None);
+        let table = cost_goal_table(vec![goal("other"), soft.clone()], &rows);
+        assert!(!table.contains("other"), "{table}");
         for line in ["| a | 1.20 ✓ |", "| b | 1.50 ✗ |", "| c | |", "| met | 1/2 |"] {
             assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
         }
-        assert_eq!(cost_goals(&rows[..1]), "");
+        assert_eq!(cost_goal_table(vec![soft], &rows[..1]), "");
     }
 }

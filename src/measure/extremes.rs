@@ -22,7 +22,8 @@ use crate::geometry::Projection;
 use crate::measure::Metrics;
 use crate::renderer::{Capture, Engine, FrameSettings};
 use crate::scene::{Camera, Ground, Light, Object, RenderSettings, Scene, primitives};
-use crate::technique::{Params, TECHNIQUES, TechniqueInfo, reference, traced};
+use crate::technique::registry::{Runs, Setting, ground_truth};
+use crate::technique::{Params, TECHNIQUES, TechniqueInfo};
 
 /// One scene of a sweep, in units of the caster: a cube of side `scale` whose bottom is
 /// `caster_height` × `scale` above the ground, lit from +x at `elevation_deg` above the horizon
@@ -213,19 +214,17 @@ pub struct ExtremeRow {
     pub truth_step: Option<f64>,
 }
 
-/// Knobs for a technique in the sweep: the GPU reference and the tracer with fewer samples
-/// than their defaults, so that the short grids stay quick on lavapipe; beyond
-/// [`TRUTH_MAX_SIZE`], where only soundness is checked, with 4 (the same code, a fraction of
-/// the minutes).
-fn sweep_knobs(info: &TechniqueInfo, setup: &Setup, long: bool) -> Vec<(&'static str, &'static str)> {
-    let huge = setup.size > TRUTH_MAX_SIZE;
-    match info.name {
-        n if n == reference::INFO.name && huge => vec![("samples", "4"), ("shadow_map_size", "256")],
-        n if n == reference::INFO.name && long => vec![("samples", "256"), ("shadow_map_size", "1024")],
-        n if n == reference::INFO.name => vec![("samples", "64"), ("shadow_map_size", "256")],
-        n if n == traced::RAYTRACE.name && huge => vec![("samples", "4")],
-        n if n == traced::RAYTRACE.name => vec![("samples", "64")],
-        _ => Vec::new(),
+/// Knobs for a technique in the sweep: its registry entry's [`SweepKnobs`] for the grid (the
+/// offline techniques take fewer samples than their defaults, so that the short grids stay
+/// quick on lavapipe; beyond [`TRUTH_MAX_SIZE`], where only soundness is checked, fewer still).
+fn sweep_knobs(info: &TechniqueInfo, setup: &Setup, long: bool) -> Setting {
+    let k = info.sweep_knobs;
+    if setup.size > TRUTH_MAX_SIZE {
+        k.huge
+    } else if long {
+        k.long
+    } else {
+        k.short
     }
 }
 
@@ -271,7 +270,7 @@ fn sweep_raw(
     for (setup, scene) in grid.iter().zip(&scenes) {
         progress(&format!("{} = {}: truth", axis.name(), axis.value(setup)));
         truths.push(if setup.size <= TRUTH_MAX_SIZE {
-            let truth = settings(setup, &traced::RAYTRACE, &[("samples", truth_samples(long))])?;
+            let truth = settings(setup, ground_truth(Runs::Cpu), &[("samples", truth_samples(long))])?;
             Some(engine.render_and_capture(scene, &truth)?)
         } else {
             None
@@ -289,7 +288,7 @@ fn sweep_raw(
         for (i, (setup, scene)) in grid.iter().zip(&scenes).enumerate() {
             progress(&format!("{} = {}: {}", axis.name(), axis.value(setup), info.name));
             let knobs = sweep_knobs(info, setup, long);
-            let capture = engine.render_and_capture(scene, &settings(setup, info, &knobs)?)?;
+            let capture = engine.render_and_capture(scene, &settings(setup, info, knobs)?)?;
             let raw = capture.raw_visibility.as_deref().expect("raw visibility is on");
             let finite = raw.iter().copied().filter(|v| v.is_finite());
             let metrics = truths[i].as_ref().map(|t| Metrics::between(&capture, t)).transpose()?;

@@ -139,7 +139,7 @@ pub fn save_difference(v: &Capture, reference: &Capture, path: &Path) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::renderer::Surfaces;
+    use crate::frame::Surfaces;
 
     fn capture(v: &[f64], depth: &[f32], receives: &[bool]) -> Capture {
         Capture {

@@ -14,8 +14,8 @@ use parry3d::shape::{CompositeShapeRef, TriMesh};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::frame::Surfaces;
 use crate::geometry::{Aabb, CameraProjection};
-use crate::renderer::Surfaces;
 use crate::scene::{Light, Scene};
 
 /// A visibility image and the surfaces it was estimated at.

@@ -6,8 +6,9 @@ use std::path::Path;
 use ash::vk;
 use glam::{Vec2, Vec3};
 
-use super::{CameraTargets, RAW_VISIBILITY_FORMAT};
+use super::CameraTargets;
 use crate::error::{Error, Result};
+use crate::frame::{RAW_VISIBILITY_FORMAT, ShadowRole, Surfaces, quantize};
 use crate::geometry::CameraProjection;
 use crate::gpu::{Buffer, Context};
 
@@ -40,26 +41,6 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
         offset += pixels * bytes;
     }
 }
-
-/// V as R16_UNORM stores it: clamped to [0, 1], rounded; NaN becomes 0 (Vulkan's conversion
-/// to normalized fixed point).
-pub fn quantize(v: f32) -> u16 {
-    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
-}
-
-/// The surfaces a visibility image was estimated at.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Surfaces {
-    /// Distance along the camera's forward axis; infinite where no surface is seen.
-    pub depth: Vec<f32>,
-    /// The facet's unit normal on the camera's side (zero where no surface is seen).
-    pub normal: Vec<Vec3>,
-    /// The surface receives shadows (V means something there).
-    pub receives: Vec<bool>,
-}
-
-/// 0.25 as an IEEE half float: shadow roles above it receive (`shadow_role` in mod.rs).
-const HALF_QUARTER: u16 = 0x3400;
 
 /// An IEEE half float's value.
 fn half_to_f32(h: u16) -> f32 {
@@ -134,9 +115,8 @@ impl Capture {
                 Vec3::new(x, y, z)
             })
             .collect();
-        // The normal target's alpha (a half float, 0, 0.5 or 1) is the shadow role; positive
-        // halfs order like their bits.
-        let receives = parts[2].chunks_exact(8).map(|b| halfs(b)[3] > HALF_QUARTER).collect();
+        // The normal target's alpha (a half float) is the shadow role.
+        let receives = parts[2].chunks_exact(8).map(|b| ShadowRole::receives(half_to_f32(halfs(b)[3]))).collect();
         let (visibility, raw_visibility) = if visibility_format == RAW_VISIBILITY_FORMAT {
             let raw: Vec<f32> =
                 parts[3].chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();

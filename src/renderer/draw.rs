@@ -1,4 +1,5 @@
-//! What the passes draw: each object's uploaded mesh and its index in the object buffer.
+//! The meshes behind the draw list: uploaded on first sight, dropped when no frame in flight
+//! draws them.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -7,6 +8,7 @@ use ash::vk;
 use bytemuck::cast_slice;
 
 use crate::error::Result;
+use crate::frame::Draw;
 use crate::geometry::Aabb;
 use crate::gpu::{Buffer, Context, upload};
 use crate::scene::{Mesh, MeshId};
@@ -18,30 +20,6 @@ pub struct GpuMesh {
     index_count: u32,
     /// Frame number of the last frame that drew it.
     last_used: u64,
-}
-
-/// One object to draw this frame.
-#[derive(Clone, Copy, Debug)]
-pub struct Draw {
-    vertices: vk::Buffer,
-    indices: vk::Buffer,
-    index_count: u32,
-    /// Index into the frame's `ObjectData` (the draw's first instance).
-    pub instance: u32,
-    pub casts: bool,
-    pub receives: bool,
-    /// World-space bounds.
-    pub bounds: Aabb,
-}
-
-impl Draw {
-    pub fn record(&self, ctx: &Context, cmd: vk::CommandBuffer) {
-        unsafe {
-            ctx.device.cmd_bind_vertex_buffers(cmd, 0, &[self.vertices], &[0]);
-            ctx.device.cmd_bind_index_buffer(cmd, self.indices, 0, vk::IndexType::UINT32);
-            ctx.device.cmd_draw_indexed(cmd, self.index_count, 1, 0, 0, self.instance);
-        }
-    }
 }
 
 /// Meshes uploaded once and dropped when no frame in flight draws them any more.

@@ -14,26 +14,20 @@ use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
-pub use capture::{Capture, Surfaces, pixel_uv, quantize};
-pub use draw::Draw;
+pub use capture::{Capture, pixel_uv};
 use draw::MeshCache;
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
 
 use crate::error::Result;
+use crate::frame::interface::{FrameGlobals, ObjectData};
+use crate::frame::{Draw, FrameInputs, RAW_VISIBILITY_FORMAT, ShadowRole, VISIBILITY_FORMAT};
 use crate::geometry::{Aabb, CameraProjection, Hexahedron, intersection_points};
 use crate::gpu::{
     Access, Buffer, Context, ContextOptions, DeviceInfo, FRAMES_IN_FLIGHT, FrameRing, PassTime, PerFrame, Target,
     TargetDesc, copy_to_host, transition,
 };
-use crate::gpu_types::{FrameGlobals, ObjectData};
 use crate::scene::{Ground, Mesh, Scene, primitives};
-use crate::technique::{self, FrameInputs, Params, Technique};
-
-/// Format of the visibility image V (DESIGN.md §3).
-pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R16_UNORM;
-/// V's format when the engine keeps raw visibility: UNORM would clamp values outside [0, 1]
-/// and turn NaN into 0 silently, hiding exactly what the stability checks look for.
-pub const RAW_VISIBILITY_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+use crate::technique::{self, Params, Technique};
 
 const AMBIENT: f32 = 0.15;
 const SKY: [f32; 3] = [0.55, 0.62, 0.72];
@@ -48,12 +42,23 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
-    /// The scene file's `[render]` table.
+    /// The scene's `[render]` table, its technique and knobs checked against the registry. An
+    /// unknown technique or a bad knob names the scene file and the line, when it has them.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
-        let info = technique::knobs::find(&scene.render.technique)?;
+        let render = &scene.render;
+        let located = |line: Option<usize>, table: &str, e: crate::Error| match &render.source {
+            Some(path) => {
+                let at = line.map_or_else(String::new, |l| format!("line {l}: "));
+                crate::Error::scene(path, format!("{at}[{table}] {e}"))
+            }
+            None => e,
+        };
+        let info = technique::find(&render.technique).map_err(|e| located(render.technique_line, "render", e))?;
         let mut params = Params::defaults(info);
-        params.apply(scene.render.params.iter().map(|(k, v)| (k.as_str(), v.as_str())))?;
-        Ok(FrameSettings { width: scene.render.width, height: scene.render.height, params })
+        for knob in &render.params {
+            params.set(&knob.key, &knob.value).map_err(|e| located(knob.line, "render.params", e))?;
+        }
+        Ok(FrameSettings { width: render.width, height: render.height, params })
     }
 }
 
@@ -308,14 +313,14 @@ impl Engine {
                 model,
                 Mat4::from_mat3(o.normal_matrix()),
                 o.color,
-                shadow_role(o.receives, o.casts),
+                ShadowRole::new(o.receives, o.casts),
             ));
         }
         if let Some(g) = &scene.ground {
             let model = ground_model(g);
             let instance = objects.len() as u32;
             draws.push(self.meshes.draw(ctx, &self.ground_mesh, number, instance, g.bounds(), (false, true))?);
-            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, shadow_role(true, false)));
+            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, ShadowRole::Receives));
         }
         let bytes: &[u8] = cast_slice(&objects);
         if self.objects.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
@@ -461,7 +466,7 @@ impl Engine {
             self.ctx.wait_idle()?;
             old.destroy(&self.ctx);
         }
-        self.technique = Some((info.name, technique::create(&self.ctx, info, self.visibility_format)?));
+        self.technique = Some((info.name, info.create(&self.ctx, self.visibility_format)?));
         Ok(())
     }
 
@@ -488,18 +493,8 @@ impl Drop for Engine {
     }
 }
 
-/// How a surface takes part in shadowing, as the prepass writes it into the normal target's
-/// alpha (`glsl/common/camera.glsl`): 0 receives no shadow, 0.5 receives, 1 receives and casts.
-fn shadow_role(receives: bool, casts: bool) -> f32 {
-    match (receives, casts) {
-        (false, _) => 0.0,
-        (true, false) => 0.5,
-        (true, true) => 1.0,
-    }
-}
-
-fn object_data(model: Mat4, normal: Mat4, color: Vec3, role: f32) -> ObjectData {
-    ObjectData { model, normal_matrix: normal, albedo: color.extend(role) }
+fn object_data(model: Mat4, normal: Mat4, color: Vec3, role: ShadowRole) -> ObjectData {
+    ObjectData { model, normal_matrix: normal, albedo: color.extend(role.encode()) }
 }
 
 /// The ground is the unit plate scaled to the ground's square, at its height.

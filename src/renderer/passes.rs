@@ -2,11 +2,12 @@
 
 use ash::vk;
 
-use super::{CameraTargets, Draw};
+use super::CameraTargets;
 use crate::error::Result;
+use crate::frame::{Draw, MESH_POSITIONS_NORMALS};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc,
-    RenderPass, VertexInput, fullscreen, shaders, transition,
+    RenderPass, fullscreen, shaders, transition,
 };
 
 /// Facet normal + shadow role, read by the techniques.
@@ -32,7 +33,7 @@ impl Prepass {
                 vertex: shaders::PREPASS_SCENE_VERT,
                 fragment: shaders::PREPASS_SCENE_FRAG,
                 bindings: &[(Binding::Uniform, both), (Binding::Storage, vertex)],
-                vertex_input: VertexInput::PositionNormal,
+                vertex_input: MESH_POSITIONS_NORMALS,
                 color_formats: &[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT],
                 // Reverse Z: nearer is greater.
                 depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),

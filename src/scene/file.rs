@@ -1,16 +1,16 @@
 //! The scene file (TOML, metres, right-handed, +Y up) of DESIGN.md §3. Unknown keys, missing
 //! files and nonsense numbers are errors that name the file and the key or line.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
 use glam::Vec3;
 use serde::Deserialize;
 
-use super::{Camera, Ground, Light, Mesh, Object, RenderSettings, Scene, Transform, primitives};
+use super::{Camera, Ground, KnobSetting, Light, Mesh, Object, RenderSettings, Scene, Transform, primitives};
 use crate::error::{Error, Result};
 use crate::geometry::Projection;
-use crate::technique::knobs;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -102,9 +102,9 @@ fn yes() -> bool {
 struct RenderFile {
     width: Option<u32>,
     height: Option<u32>,
-    technique: Option<String>,
+    technique: Option<toml::Spanned<String>>,
     #[serde(default)]
-    params: toml::Table,
+    params: BTreeMap<toml::Spanned<String>, toml::Value>,
 }
 
 /// Albedos for objects that name no color: distinct, mid-bright, linear RGB.
@@ -160,30 +160,37 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
         .map(|(i, o)| object(o, i, base).map_err(|what| err(format!("[[object]] {} ({:?}): {what}", i + 1, o.shape))))
         .collect::<Result<Vec<_>>>()?;
 
+    // The technique and its knobs are checked by the frame settings, which know the
+    // techniques; the lines kept here let them name where a typo is.
+    let line = |span: std::ops::Range<usize>| text[..span.start.min(text.len())].matches('\n').count() + 1;
     let defaults = RenderSettings::default();
+    let technique_line = file.render.technique.as_ref().map(|t| line(t.span()));
     let render = RenderSettings {
         width: file.render.width.unwrap_or(defaults.width),
         height: file.render.height.unwrap_or(defaults.height),
-        technique: file.render.technique.unwrap_or(defaults.technique),
+        technique: file.render.technique.map_or(defaults.technique, toml::Spanned::into_inner),
         params: file
             .render
             .params
             .iter()
-            .map(|(k, v)| match v {
-                toml::Value::Integer(n) => Ok((k.clone(), n.to_string())),
-                toml::Value::Float(x) => Ok((k.clone(), x.to_string())),
-                toml::Value::String(s) => Ok((k.clone(), s.clone())),
-                other => {
-                    Err(err(format!("[render.params] `{k}` must be a number or a string, got {}", other.type_str())))
-                }
+            .map(|(k, v)| {
+                let value = match v {
+                    toml::Value::Integer(n) => n.to_string(),
+                    toml::Value::Float(x) => x.to_string(),
+                    toml::Value::String(s) => s.clone(),
+                    other => {
+                        let k = k.get_ref();
+                        let what =
+                            format!("[render.params] `{k}` must be a number or a string, got {}", other.type_str());
+                        return Err(err(what));
+                    }
+                };
+                Ok(KnobSetting { key: k.get_ref().clone(), value, line: Some(line(k.span())) })
             })
             .collect::<Result<_>>()?,
+        source: Some(path.to_path_buf()),
+        technique_line,
     };
-    // Check the technique and its knobs now, so a typo fails at load time with the file named.
-    let mut params = knobs::Params::defaults(knobs::find(&render.technique).map_err(|e| err(format!("[render] {e}")))?);
-    params
-        .apply(render.params.iter().map(|(k, v)| (k.as_str(), v.as_str())))
-        .map_err(|e| err(format!("[render.params] {e}")))?;
 
     let scene = Scene { camera, light, ground, objects, render };
     scene.validate().map_err(|e| err(e.to_string()))?;

@@ -6,9 +6,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::Vec3;
 
-use super::adjacency::EdgeAdjacency;
 use crate::error::{Error, Result};
-use crate::geometry::Aabb;
+use crate::geometry::{Aabb, EdgeAdjacency};
 
 /// Identifies a mesh for the GPU cache; unique for the life of the process.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -1,10 +1,10 @@
 //! Pure scene data: the TOML format of DESIGN.md §3, meshes and their edge adjacency.
 
-mod adjacency;
 mod file;
 mod mesh;
 pub mod primitives;
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
@@ -12,7 +12,7 @@ use glam::{EulerRot, Mat3, Mat4, Quat, Vec3};
 use crate::error::{Error, Result};
 use crate::geometry::Aabb;
 pub use crate::geometry::Projection;
-pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
+pub use crate::geometry::{Edge, EdgeAdjacency, NO_FACE};
 pub use mesh::{Mesh, MeshId, Vertex};
 
 /// Where the camera is and how it projects.
@@ -111,18 +111,38 @@ impl Object {
 }
 
 /// Image size and technique as the scene file gives them; the command line may override.
+/// The technique and its knobs are text here: the frame settings check them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
     pub height: u32,
     pub technique: String,
-    /// `[render.params]` as KEY, VALUE text, checked against the technique's knobs.
-    pub params: Vec<(String, String)>,
+    /// `[render.params]`, in key order.
+    pub params: Vec<KnobSetting>,
+    /// The scene file these came from, and the line of `technique` in it: where an unknown
+    /// technique or knob is reported.
+    pub source: Option<PathBuf>,
+    pub technique_line: Option<usize>,
+}
+
+/// One `[render.params]` entry: a knob's name and value as text, and its line in the file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnobSetting {
+    pub key: String,
+    pub value: String,
+    pub line: Option<usize>,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { width: 512, height: 512, technique: "shadow-map".into(), params: Vec::new() }
+        RenderSettings {
+            width: 512,
+            height: 512,
+            technique: "shadow-map".into(),
+            params: Vec::new(),
+            source: None,
+            technique_line: None,
+        }
     }
 }
 

@@ -1,91 +1,28 @@
-//! Procedural closed meshes centred on the origin, counter-clockwise seen from outside.
-
-use std::f32::consts::TAU;
+//! Procedural closed meshes centred on the origin, counter-clockwise seen from outside
+//! ([`geometry::shapes`](crate::geometry::shapes) made into [`Mesh`]es).
 
 use glam::Vec3;
 
 use super::mesh::Mesh;
 use crate::error::Result;
-
-/// Segments around a sphere or cylinder: 15° steps, smooth under the 40° crease rule.
-const SEGMENTS: u32 = 24;
-const SPHERE_RINGS: u32 = 16;
+use crate::geometry::shapes;
 
 /// A box of `size`; a zero `size.y` makes a plate: two back-to-back quads sharing their rim, a
 /// closed surface of zero thickness (each rim edge has its two faces).
 pub fn cuboid(size: Vec3) -> Result<Mesh> {
-    let h = size * 0.5;
-    if size.y == 0.0 {
-        let p = vec![
-            Vec3::new(-h.x, 0.0, -h.z),
-            Vec3::new(h.x, 0.0, -h.z),
-            Vec3::new(h.x, 0.0, h.z),
-            Vec3::new(-h.x, 0.0, h.z),
-        ];
-        // Top faces +Y; the bottom uses the other diagonal so no edge joins four faces.
-        let tris = vec![[0, 2, 1], [0, 3, 2], [0, 1, 3], [1, 2, 3]];
-        return Mesh::new("plate", p, tris);
-    }
-    let p: Vec<Vec3> = (0..8)
-        .map(|i| {
-            Vec3::new(
-                if i & 1 == 0 { -h.x } else { h.x },
-                if i & 2 == 0 { -h.y } else { h.y },
-                if i & 4 == 0 { -h.z } else { h.z },
-            )
-        })
-        .collect();
-    // Each face as a quad listed counter-clockwise from outside.
-    let quads = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
-    let tris = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
-    Mesh::new("box", p, tris)
+    let (p, tris) = shapes::cuboid(size);
+    Mesh::new(if size.y == 0.0 { "plate" } else { "box" }, p, tris)
 }
 
 /// A UV sphere with welded poles.
 pub fn sphere(radius: f32) -> Result<Mesh> {
-    let mut p = vec![Vec3::new(0.0, radius, 0.0)];
-    for ring in 1..SPHERE_RINGS {
-        let theta = std::f32::consts::PI * ring as f32 / SPHERE_RINGS as f32;
-        for s in 0..SEGMENTS {
-            let phi = TAU * s as f32 / SEGMENTS as f32;
-            p.push(radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin()));
-        }
-    }
-    p.push(Vec3::new(0.0, -radius, 0.0));
-    let south = p.len() as u32 - 1;
-    let at = |ring: u32, s: u32| 1 + (ring - 1) * SEGMENTS + s % SEGMENTS;
-    let mut tris = Vec::new();
-    for s in 0..SEGMENTS {
-        tris.push([0, at(1, s), at(1, s + 1)]);
-        tris.push([south, at(SPHERE_RINGS - 1, s + 1), at(SPHERE_RINGS - 1, s)]);
-        for ring in 1..SPHERE_RINGS - 1 {
-            let (a, b, c, d) = (at(ring, s), at(ring + 1, s), at(ring + 1, s + 1), at(ring, s + 1));
-            tris.push([a, b, c]);
-            tris.push([a, c, d]);
-        }
-    }
+    let (p, tris) = shapes::sphere(radius);
     Mesh::new("sphere", p, tris)
 }
 
 /// A capped cylinder along Y, centred on the origin.
 pub fn cylinder(radius: f32, height: f32) -> Result<Mesh> {
-    let h = height * 0.5;
-    let mut p = vec![Vec3::new(0.0, h, 0.0), Vec3::new(0.0, -h, 0.0)];
-    for s in 0..SEGMENTS {
-        let phi = TAU * s as f32 / SEGMENTS as f32;
-        let (x, z) = (radius * phi.cos(), -radius * phi.sin());
-        p.push(Vec3::new(x, h, z));
-        p.push(Vec3::new(x, -h, z));
-    }
-    let top = |s: u32| 2 + 2 * (s % SEGMENTS);
-    let bottom = |s: u32| 3 + 2 * (s % SEGMENTS);
-    let mut tris = Vec::new();
-    for s in 0..SEGMENTS {
-        tris.push([0, top(s), top(s + 1)]);
-        tris.push([1, bottom(s + 1), bottom(s)]);
-        tris.push([top(s), bottom(s), bottom(s + 1)]);
-        tris.push([top(s), bottom(s + 1), top(s + 1)]);
-    }
+    let (p, tris) = shapes::cylinder(radius, height);
     Mesh::new("cylinder", p, tris)
 }
 

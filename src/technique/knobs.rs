@@ -1,8 +1,10 @@
-//! The techniques' names and knobs as data: what `softshadow techniques` lists, and what scene
-//! files and `--set KEY=VALUE` are checked against.
+//! Technique knobs as data: what `softshadow techniques` lists, and what scene files and
+//! `--set KEY=VALUE` are checked against. A technique reads its knobs through the [`Knob`]
+//! constants it declares, so a misspelled name does not compile.
 
 use std::collections::BTreeMap;
 
+use super::registry::TechniqueInfo;
 use crate::error::{Error, Result};
 
 /// One tunable number of a technique.
@@ -17,34 +19,11 @@ pub struct Knob {
     pub help: &'static str,
 }
 
-/// A technique as the command line and scene files see it.
-#[derive(Debug)]
-pub struct TechniqueInfo {
-    pub name: &'static str,
-    pub summary: &'static str,
-    pub knobs: &'static [Knob],
-    /// Takes seconds per frame (ground truth, CPU tracers): tools render it once, unwarmed.
-    pub offline: bool,
-}
-
-/// Every technique this build knows.
-pub const TECHNIQUES: &[&TechniqueInfo] = &[
-    &crate::technique::shadow_map::INFO,
-    &crate::technique::shadow_map::PCF,
-    &crate::technique::shadow_map::PCSS,
-    &crate::technique::plateau::INFO,
-    &crate::technique::smoothie::INFO,
-    &crate::technique::reference::INFO,
-    &crate::technique::traced::RAYTRACE,
-    &crate::technique::traced::PARKER,
-];
-
-/// Looks a technique up by name.
-pub fn find(name: &str) -> Result<&'static TechniqueInfo> {
-    TECHNIQUES.iter().copied().find(|t| t.name == name).ok_or_else(|| {
-        let names: Vec<_> = TECHNIQUES.iter().map(|t| t.name).collect();
-        Error::Invalid(format!("unknown technique `{name}` (known: {})", names.join(", ")))
-    })
+impl Knob {
+    /// A knob that is off (0, the default) or on (1).
+    pub const fn switch(name: &'static str, help: &'static str) -> Self {
+        Knob { name, default: 0.0, min: 0.0, max: 1.0, integer: true, help }
+    }
 }
 
 /// Validated knob values of one technique; unset knobs take their defaults.
@@ -87,9 +66,20 @@ impl Params {
         pairs.into_iter().try_for_each(|(k, v)| self.set(k, v))
     }
 
-    /// The value of a knob this technique declares.
-    pub(crate) fn get(&self, name: &str) -> f64 {
-        self.values[name]
+    /// The value of `knob`, one the technique declares (debug builds check that it does).
+    pub fn get(&self, knob: &Knob) -> f64 {
+        debug_assert!(
+            self.values.contains_key(knob.name),
+            "`{}` reads undeclared knob `{}`",
+            self.technique.name,
+            knob.name
+        );
+        self.values.get(knob.name).copied().unwrap_or(knob.default)
+    }
+
+    /// An on/off knob (0 or 1) is on.
+    pub fn is_on(&self, knob: &Knob) -> bool {
+        self.get(knob) != 0.0
     }
 }
 
@@ -105,15 +95,7 @@ impl std::fmt::Display for Params {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn defaults_lie_in_their_ranges() {
-        for t in TECHNIQUES {
-            for k in t.knobs {
-                assert!(k.min <= k.default && k.default <= k.max, "{}.{}", t.name, k.name);
-            }
-        }
-    }
+    use crate::technique::registry::find;
 
     #[test]
     fn bad_knobs_are_named() {

@@ -5,41 +5,19 @@ mod falloff;
 pub mod knobs;
 pub mod plateau;
 pub mod reference;
+pub mod registry;
 pub mod shadow_map;
 pub mod smoothie;
 mod smoothie_gpu;
 pub mod traced;
 
 use ash::vk;
-use glam::Vec3;
 
 use crate::error::Result;
-use crate::geometry::CameraProjection;
-use crate::gpu::{Context, PassTimer, Target};
-use crate::renderer::Draw;
-use crate::scene::Scene;
-pub use knobs::{Params, TECHNIQUES, TechniqueInfo};
-
-/// What a technique reads while it records one frame.
-pub struct FrameInputs<'a> {
-    pub ctx: &'a Context,
-    pub cmd: vk::CommandBuffer,
-    /// Frame-in-flight slot: selects per-frame buffers.
-    pub slot: usize,
-    pub timer: &'a mut PassTimer,
-    pub scene: &'a Scene,
-    pub camera: &'a CameraProjection,
-    /// `FrameGlobals` of this frame.
-    pub globals: vk::DescriptorBufferInfo,
-    /// `ObjectData` of every draw.
-    pub objects: vk::DescriptorBufferInfo,
-    pub draws: &'a [Draw],
-    /// Camera depth and normal, ready to be sampled.
-    pub depth: &'a Target,
-    pub normal: &'a Target,
-    /// Points whose hull is the receivers' visible part: no shadow matters outside it.
-    pub receivers_in_view: &'a [Vec3],
-}
+use crate::frame::{FrameInputs, Surfaces};
+use crate::gpu::{Context, Target};
+pub use knobs::{Knob, Params};
+pub use registry::{Kind, Runs, TECHNIQUES, TechniqueInfo, find};
 
 /// A shadowing technique: records its passes and leaves V written (the composite transitions
 /// it from whichever access wrote it).
@@ -47,7 +25,7 @@ pub trait Technique {
     fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()>;
     /// The surfaces V was estimated at in the last frame, when the technique found them itself
     /// (a ray tracer) instead of reading the prepass.
-    fn traced_surfaces(&self) -> Option<&crate::renderer::Surfaces> {
+    fn traced_surfaces(&self) -> Option<&Surfaces> {
         None
     }
     /// For GPU work of many seconds: (steps done, steps) of the frame in `slot`, polled while
@@ -56,21 +34,6 @@ pub trait Technique {
         None
     }
     fn destroy(self: Box<Self>, ctx: &Context);
-}
-
-/// Creates the technique `info` names.
-pub fn create(ctx: &Context, info: &'static TechniqueInfo, visibility: vk::Format) -> Result<Box<dyn Technique>> {
-    match info.name {
-        name if [shadow_map::INFO.name, shadow_map::PCF.name, shadow_map::PCSS.name].contains(&name) => {
-            Ok(Box::new(shadow_map::ShadowMap::new(ctx, info, visibility)?))
-        }
-        name if name == reference::INFO.name => Ok(Box::new(reference::Reference::new(ctx, visibility)?)),
-        name if name == plateau::INFO.name => Ok(Box::new(plateau::Plateau::new(ctx, visibility)?)),
-        name if name == smoothie::INFO.name => Ok(Box::new(smoothie::Smoothie::new(ctx, visibility)?)),
-        name if name == traced::RAYTRACE.name => Ok(Box::new(traced::Traced::new(traced::Method::Exact))),
-        name if name == traced::PARKER.name => Ok(Box::new(traced::Traced::new(traced::Method::Parker))),
-        other => Err(crate::Error::Invalid(format!("technique `{other}` is listed but not built"))),
-    }
 }
 
 /// The first inputs of every resolve that reads the camera's surfaces, in binding order: the

@@ -28,9 +28,13 @@ use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec2, Vec4};
 
 use super::falloff::{FALLOFF, Falloff};
-use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
+use super::knobs::{Knob, Params};
+use super::registry::{CostGoal, Kind, SweepKnobs, TechniqueInfo};
+use super::shadow_map;
+use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
+use crate::frame::interface::PlateauView;
+use crate::frame::{FrameInputs, MESH_POSITIONS};
 use crate::geometry::plateau::{
     PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides,
 };
@@ -39,7 +43,6 @@ use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
     Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, shaders, transition,
 };
-use crate::gpu_types::PlateauView;
 
 /// Cone radius / the true penumbra's half width, physical mode: what measured best against the
 /// reference (N = 256, 256², linear falloff): RMSE 0.0419, 0.0413, 0.0419, 0.0432, 0.0463 on
@@ -48,60 +51,64 @@ use crate::gpu_types::PlateauView;
 pub const PLATEAU_SCALE: f64 = 0.4;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
-    offline: false,
     name: "plateau",
     summary: "Haines' plateaus: hard drop shadow + cones and sheets at silhouettes, on the ground plane",
-    knobs: &[
-        Knob {
-            name: "texture_size",
-            default: 1024.0,
-            min: 16.0,
-            max: 8192.0,
-            integer: true,
-            help: "plateau texture width and height, in texels",
-        },
-        Knob {
-            name: "size_mode",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "0: penumbra from the light sphere; 1: Haines' constant factor times height",
-        },
-        Knob {
-            name: "penumbra_scale",
-            default: PLATEAU_SCALE,
-            min: 0.0,
-            max: 8.0,
-            integer: false,
-            help: "physical mode: cone radius as a multiple of the true penumbra's half width",
-        },
-        Knob {
-            name: "haines_factor",
-            default: 0.1,
-            min: 0.0,
-            max: 10.0,
-            integer: false,
-            help: "size_mode 1: cone radius per unit of height (Haines used 0.1)",
-        },
-        FALLOFF,
-        Knob {
-            name: "edges",
-            default: 0.0,
-            min: 0.0,
-            max: 2.0,
-            integer: true,
-            help: "0 auto (silhouettes; light-facing polygons for open meshes), 1 silhouettes, 2 polygons",
-        },
-        Knob {
-            name: "off_plane",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "receivers off the plane: 0 unshadowed, 1 the projected light map",
-        },
-    ],
+    kind: Kind::Realtime,
+    knobs: &[TEXTURE_SIZE, SIZE_MODE, PENUMBRA_SCALE, HAINES_FACTOR, FALLOFF, EDGES, OFF_PLANE],
+    create: |ctx, _, visibility| Ok(Box::new(Plateau::new(ctx, visibility)?)),
+    bench: &[&[], &[("falloff", "1")], &[("texture_size", "512")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    // Issue 4: plateaus against the hard map at the same screen size.
+    cost_goal: Some(CostGoal { setting: &[], baseline: &shadow_map::INFO, baseline_setting: &[], max_ratio: 1.3 }),
+};
+
+const TEXTURE_SIZE: Knob = Knob {
+    name: "texture_size",
+    default: 1024.0,
+    min: 16.0,
+    max: 8192.0,
+    integer: true,
+    help: "plateau texture width and height, in texels",
+};
+const SIZE_MODE: Knob = Knob {
+    name: "size_mode",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "0: penumbra from the light sphere; 1: Haines' constant factor times height",
+};
+const PENUMBRA_SCALE: Knob = Knob {
+    name: "penumbra_scale",
+    default: PLATEAU_SCALE,
+    min: 0.0,
+    max: 8.0,
+    integer: false,
+    help: "physical mode: cone radius as a multiple of the true penumbra's half width",
+};
+const HAINES_FACTOR: Knob = Knob {
+    name: "haines_factor",
+    default: 0.1,
+    min: 0.0,
+    max: 10.0,
+    integer: false,
+    help: "size_mode 1: cone radius per unit of height (Haines used 0.1)",
+};
+const EDGES: Knob = Knob {
+    name: "edges",
+    default: 0.0,
+    min: 0.0,
+    max: 2.0,
+    integer: true,
+    help: "0 auto (silhouettes; light-facing polygons for open meshes), 1 silhouettes, 2 polygons",
+};
+const OFF_PLANE: Knob = Knob {
+    name: "off_plane",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "receivers off the plane: 0 unshadowed, 1 the projected light map",
 };
 
 const PLATEAU_FORMAT: vk::Format = vk::Format::R16_UNORM;
@@ -144,7 +151,7 @@ impl Plateau {
                 vertex: shaders::PLATEAU_UMBRA_VERT,
                 fragment: shaders::PLATEAU_UMBRA_FRAG,
                 bindings: &[(Binding::Uniform, vertex), (Binding::Storage, vertex)],
-                vertex_input: VertexInput::Position,
+                vertex_input: MESH_POSITIONS,
                 color_formats: &[PLATEAU_FORMAT],
                 depth,
                 blend: Blend::None,
@@ -268,10 +275,10 @@ impl Technique for Plateau {
         let ctx = frame.ctx;
         let plane = ReceiverPlane::ground(ground.height);
         let scene_light = &frame.scene.light;
-        let size = if params.get("size_mode") == 1.0 {
-            PenumbraSize::Haines { factor: params.get("haines_factor") as f32 }
+        let size = if params.is_on(&SIZE_MODE) {
+            PenumbraSize::Haines { factor: params.get(&HAINES_FACTOR) as f32 }
         } else {
-            PenumbraSize::Physical { scale: params.get("penumbra_scale") as f32 }
+            PenumbraSize::Physical { scale: params.get(&PENUMBRA_SCALE) as f32 }
         };
         let light = PlateauLight {
             position: scene_light.position,
@@ -279,10 +286,10 @@ impl Technique for Plateau {
             size,
             cone_segments: CONE_SEGMENTS,
         };
-        self.build_sides(frame, &plane, light, params.get("edges"));
+        self.build_sides(frame, &plane, light, params.get(&EDGES));
         let mut geometry = PlateauGeometry::default();
         self.sides.iter().flatten().for_each(|(_, g)| geometry.extend(g));
-        let tex_size = params.get("texture_size") as u32;
+        let tex_size = params.get(&TEXTURE_SIZE) as u32;
         ensure(ctx, &mut self.texture, TargetDesc::color("plateau texture", PLATEAU_FORMAT, tex_size, tex_size))?;
         ensure(ctx, &mut self.depth, TargetDesc::depth("plateau depth", tex_size, tex_size))?;
         let Some(window) = self.window(&plane, &geometry, frame) else {
@@ -300,8 +307,8 @@ impl Technique for Plateau {
         let view = PlateauView {
             umbra: to_clip * plane.shadow_matrix(light.position),
             plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
-            plane_normal: plane.normal.extend(params.get("off_plane") as f32),
-            plane_u: plane.u.extend(params.get("falloff") as f32),
+            plane_normal: plane.normal.extend(params.get(&OFF_PLANE) as f32),
+            plane_u: plane.u.extend(params.get(&FALLOFF) as f32),
             plane_v: plane.v.extend(0.0),
             window,
         };

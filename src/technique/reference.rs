@@ -17,40 +17,50 @@ use ash::vk;
 use bytemuck::{Zeroable as _, cast_slice};
 use glam::{Vec3, Vec4};
 
-use super::knobs::{Knob, Params, TechniqueInfo};
-use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, depth_pipeline, draw_casters};
-use super::{FrameInputs, Technique, clear_visibility, resolve};
+use super::knobs::{Knob, Params};
+use super::registry::{Kind, Runs, SweepKnobs, TechniqueInfo};
+use super::shadow_map::{DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, depth_pipeline, draw_casters};
+use super::{Technique, clear_visibility, resolve};
 use crate::error::Result;
+use crate::frame::FrameInputs;
+use crate::frame::interface::{LightSample, LightView};
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Milestones, PerFrame,
     Pipeline, RenderPass, Target, TargetDesc, ensure, shaders, transition,
 };
-use crate::gpu_types::{LightSample, LightView};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
-    offline: true,
     name: "reference",
     summary: "ground truth: N hard shadows from points on the light, weighted by solid angle (Heckbert & Herf)",
-    knobs: &[
-        Knob {
-            name: "samples",
-            default: 256.0,
-            min: 1.0,
-            max: 4096.0,
-            integer: true,
-            help: "points on the light, one shadow map each",
-        },
-        Knob { default: 1024.0, max: 4096.0, ..SHADOW_MAP_SIZE },
-    ],
+    kind: Kind::GroundTruth(Runs::Gpu),
+    knobs: &[SAMPLES, MAP_SIZE],
+    create: |ctx, _, visibility| Ok(Box::new(Reference::new(ctx, visibility)?)),
+    bench: &[],
+    // Fewer samples than the default keep the short grids quick on lavapipe; beyond the size
+    // where only soundness is checked, 4 (the same code, a fraction of the minutes).
+    sweep_knobs: SweepKnobs {
+        short: &[("samples", "64"), ("shadow_map_size", "256")],
+        long: &[("samples", "256"), ("shadow_map_size", "1024")],
+        huge: &[("samples", "4"), ("shadow_map_size", "256")],
+    },
+    cost_goal: None,
 };
+
+const SAMPLES: Knob = Knob {
+    name: "samples",
+    default: 256.0,
+    min: 1.0,
+    max: 4096.0,
+    integer: true,
+    help: "points on the light, one shadow map each",
+};
+const MAP_SIZE: Knob = Knob { default: 1024.0, max: 4096.0, ..SHADOW_MAP_SIZE };
 
 /// Tiles per atlas side at most: 16 shadow maps per accumulation pass.
 const MAX_TILES: u32 = 4;
 const SAMPLE_BYTES: u64 = std::mem::size_of::<LightSample>() as u64;
 const SUM_FORMAT: vk::Format = vk::Format::R32G32_SFLOAT;
-/// Texel biases of the sample maps: the `shadow-map` defaults.
-const BIAS: [f32; 3] = [1.0, 1.0, 1.5];
 
 pub struct Reference {
     depth: Pipeline,
@@ -126,7 +136,7 @@ impl Reference {
                     view: f.view,
                     view_proj: f.view_proj,
                     extent: Vec4::from(f.window),
-                    bias: Vec4::new(BIAS[0], BIAS[1], BIAS[2], size as f32),
+                    bias: Vec4::from((Vec3::from(DEFAULT_BIASES), size as f32)),
                     kernel: Vec4::ZERO,
                 });
                 let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
@@ -147,8 +157,8 @@ impl Technique for Reference {
             return clear_visibility(frame, visibility);
         }
         let ctx = frame.ctx;
-        let size = params.get("shadow_map_size") as u32;
-        let samples = Self::light_samples(frame, params.get("samples") as usize, size);
+        let size = params.get(&MAP_SIZE) as u32;
+        let samples = Self::light_samples(frame, params.get(&SAMPLES) as usize, size);
 
         let bytes = samples.len() as u64 * SAMPLE_BYTES;
         if self.samples.as_ref().is_none_or(|b| b.capacity() < bytes) {

@@ -13,92 +13,86 @@ use ash::vk;
 use bytemuck::bytes_of;
 use glam::{Vec3, Vec4};
 
-use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
+use super::knobs::{Knob, Params};
+use super::registry::{Kind, SweepKnobs, TechniqueInfo};
+use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
+use crate::frame::interface::LightView;
+use crate::frame::{FrameInputs, MESH_POSITIONS};
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
     Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, ensure, shaders, transition,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, ensure, shaders, transition,
 };
-use crate::gpu_types::LightView;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
-    offline: false,
     name: "shadow-map",
     summary: "hard shadows from the light's centre: one shadow map, 2x2 bilinear comparison",
+    kind: Kind::Realtime,
     knobs: &[SHADOW_MAP_SIZE, DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET],
+    create: ShadowMap::create,
+    bench: &[&[], &[("shadow_map_size", "1024")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    cost_goal: None,
 };
 
 /// Percentage-closer filtering (Reeves, Salesin & Cook 1987) on the same map.
 pub const PCF: TechniqueInfo = TechniqueInfo {
-    offline: false,
     name: "pcf",
     summary: "percentage-closer filtering: a rotated Vogel disk of taps, or the 4x4 bicubic of smoothie Fig. 7",
-    knobs: &[
-        SHADOW_MAP_SIZE,
-        DEPTH_BIAS,
-        SLOPE_BIAS,
-        NORMAL_OFFSET,
-        Knob { name: "taps", default: 16.0, min: 1.0, max: 32.0, integer: true, help: "comparisons on the disk" },
-        Knob {
-            name: "radius",
-            default: 2.0,
-            min: 0.0,
-            max: 256.0,
-            integer: false,
-            help: "disk radius, in texels (or world units with radius_world = 1)",
-        },
-        Knob {
-            name: "radius_world",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "1: radius in world units at the receiver; 0: in shadow-map texels",
-        },
-        Knob {
-            name: "bicubic",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "1: a 4x4 bicubic B-spline footprint instead of the disk",
-        },
-    ],
+    kind: Kind::Realtime,
+    knobs: &[SHADOW_MAP_SIZE, DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET, TAPS, RADIUS, RADIUS_WORLD, BICUBIC],
+    create: ShadowMap::create,
+    bench: &[&[("taps", "16")], &[("taps", "4")], &[("taps", "32")], &[("bicubic", "1")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    cost_goal: None,
 };
 
 /// Percentage-closer soft shadows (Fernando 2005) on the same map.
 pub const PCSS: TechniqueInfo = TechniqueInfo {
-    offline: false,
     name: "pcss",
     summary: "percentage-closer soft shadows: blocker search, penumbra from similar triangles, PCF",
-    knobs: &[
-        SHADOW_MAP_SIZE,
-        DEPTH_BIAS,
-        SLOPE_BIAS,
-        NORMAL_OFFSET,
-        Knob {
-            name: "blocker_samples",
-            default: 16.0,
-            min: 1.0,
-            max: 64.0,
-            integer: true,
-            help: "taps of the blocker search",
-        },
-        Knob { name: "filter_samples", default: 16.0, min: 1.0, max: 64.0, integer: true, help: "taps of the PCF" },
-        Knob {
-            name: "light_size_scale",
-            default: 1.0,
-            min: 0.0,
-            max: 16.0,
-            integer: false,
-            help: "light size used, as a multiple of the scene light's radius",
-        },
-    ],
+    kind: Kind::Realtime,
+    knobs: &[SHADOW_MAP_SIZE, DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET, BLOCKER_SAMPLES, FILTER_SAMPLES, LIGHT_SIZE_SCALE],
+    create: ShadowMap::create,
+    bench: &[&[], &[("blocker_samples", "32"), ("filter_samples", "32")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    cost_goal: None,
 };
 
-const DEPTH_BIAS: Knob = Knob {
+const TAPS: Knob =
+    Knob { name: "taps", default: 16.0, min: 1.0, max: 32.0, integer: true, help: "comparisons on the disk" };
+const RADIUS: Knob = Knob {
+    name: "radius",
+    default: 2.0,
+    min: 0.0,
+    max: 256.0,
+    integer: false,
+    help: "disk radius, in texels (or world units with radius_world = 1)",
+};
+const RADIUS_WORLD: Knob =
+    Knob::switch("radius_world", "1: radius in world units at the receiver; 0: in shadow-map texels");
+const BICUBIC: Knob = Knob::switch("bicubic", "1: a 4x4 bicubic B-spline footprint instead of the disk");
+const BLOCKER_SAMPLES: Knob = Knob {
+    name: "blocker_samples",
+    default: 16.0,
+    min: 1.0,
+    max: 64.0,
+    integer: true,
+    help: "taps of the blocker search",
+};
+const FILTER_SAMPLES: Knob =
+    Knob { name: "filter_samples", default: 16.0, min: 1.0, max: 64.0, integer: true, help: "taps of the PCF" };
+const LIGHT_SIZE_SCALE: Knob = Knob {
+    name: "light_size_scale",
+    default: 1.0,
+    min: 0.0,
+    max: 16.0,
+    integer: false,
+    help: "light size used, as a multiple of the scene light's radius",
+};
+
+pub(crate) const DEPTH_BIAS: Knob = Knob {
     name: "depth_bias",
     default: 1.0,
     min: 0.0,
@@ -106,7 +100,7 @@ const DEPTH_BIAS: Knob = Knob {
     integer: false,
     help: "constant depth bias, in shadow-map texels",
 };
-const SLOPE_BIAS: Knob = Knob {
+pub(crate) const SLOPE_BIAS: Knob = Knob {
     name: "slope_bias",
     default: 1.0,
     min: 0.0,
@@ -114,7 +108,7 @@ const SLOPE_BIAS: Knob = Knob {
     integer: false,
     help: "depth bias per unit tan(angle to the light), in texels",
 };
-const NORMAL_OFFSET: Knob = Knob {
+pub(crate) const NORMAL_OFFSET: Knob = Knob {
     name: "normal_offset",
     default: 1.5,
     min: 0.0,
@@ -133,6 +127,15 @@ pub const SHADOW_MAP_SIZE: Knob = Knob {
     help: "shadow map width and height, in texels",
 };
 
+/// The constant, slope-scaled and normal-offset biases, in shadow-map texels.
+pub(crate) fn texel_biases(params: &Params) -> [f32; 3] {
+    [DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET].map(|k| params.get(&k) as f32)
+}
+
+/// The biases at their defaults, for techniques that render shadow maps without exposing them.
+pub(crate) const DEFAULT_BIASES: [f32; 3] =
+    [DEPTH_BIAS.default as f32, SLOPE_BIAS.default as f32, NORMAL_OFFSET.default as f32];
+
 /// Linear depth cleared beyond any caster: "nothing blocks this texel".
 pub(crate) const EMPTY_DEPTH: f32 = f32::MAX;
 
@@ -149,7 +152,7 @@ pub(crate) fn depth_pipeline(ctx: &Context, format: vk::Format) -> Result<Pipeli
                 (Binding::Uniform, vk::ShaderStageFlags::VERTEX),
                 (Binding::Storage, vk::ShaderStageFlags::VERTEX),
             ],
-            vertex_input: VertexInput::Position,
+            vertex_input: MESH_POSITIONS,
             color_formats: &[format],
             depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
             blend: Blend::None,
@@ -288,6 +291,11 @@ impl ShadowMap {
         Ok(ShadowMap { technique, pass, resolves: Vec::new(), visibility })
     }
 
+    /// The registry's constructor of the family.
+    fn create(ctx: &Context, technique: &'static TechniqueInfo, visibility: vk::Format) -> Result<Box<dyn Technique>> {
+        Ok(Box::new(ShadowMap::new(ctx, technique, visibility)?))
+    }
+
     /// Index in `resolves` of the pipeline for `filter`, made on first use.
     fn resolve(&mut self, ctx: &Context, filter: Filter) -> Result<usize> {
         if let Some(i) = self.resolves.iter().position(|(f, _)| *f == filter) {
@@ -304,14 +312,14 @@ impl ShadowMap {
     /// The filter and its `LightView.filter` parameters for this frame's knobs.
     fn filter(&self, params: &Params, frame: &FrameInputs<'_>, frustum: &LightFrustum) -> (Filter, Vec4) {
         match self.technique.name {
-            name if name == PCF.name && params.get("bicubic") == 1.0 => (Filter::Bicubic, Vec4::ZERO),
+            name if name == PCF.name && params.is_on(&BICUBIC) => (Filter::Bicubic, Vec4::ZERO),
             name if name == PCF.name => {
-                let [taps, radius, world] = ["taps", "radius", "radius_world"].map(|k| params.get(k) as f32);
+                let [taps, radius, world] = [TAPS, RADIUS, RADIUS_WORLD].map(|k| params.get(&k) as f32);
                 (Filter::Disk, Vec4::new(taps, radius, world, 0.0))
             }
             name if name == PCSS.name => {
-                let radius = frame.scene.light.radius * params.get("light_size_scale") as f32;
-                let [taps, blockers] = ["filter_samples", "blocker_samples"].map(|k| params.get(k) as f32);
+                let radius = frame.scene.light.radius * params.get(&LIGHT_SIZE_SCALE) as f32;
+                let [taps, blockers] = [FILTER_SAMPLES, BLOCKER_SAMPLES].map(|k| params.get(&k) as f32);
                 (Filter::Pcss, Vec4::new(taps, radius, frustum.near, blockers))
             }
             _ => (Filter::Hard, Vec4::ZERO),
@@ -324,8 +332,8 @@ impl Technique for ShadowMap {
         let Some(frustum) = ShadowMapPass::fit(frame) else {
             return clear_visibility(frame, visibility);
         };
-        let size = params.get("shadow_map_size") as u32;
-        let bias = ["depth_bias", "slope_bias", "normal_offset"].map(|k| params.get(k) as f32);
+        let size = params.get(&SHADOW_MAP_SIZE) as u32;
+        let bias = texel_biases(params);
         let (filter, filter_params) = self.filter(params, frame, &frustum);
         self.pass.record(frame, &frustum, size, bias, filter_params)?;
 

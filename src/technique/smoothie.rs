@@ -24,11 +24,13 @@ use bytemuck::cast_slice;
 use glam::{Mat4, Vec3, Vec4};
 
 use super::falloff::{FALLOFF, Falloff};
-use super::knobs::{Knob, Params, TechniqueInfo};
-use super::shadow_map::{EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
+use super::knobs::{Knob, Params};
+use super::registry::{CostGoal, Kind, SweepKnobs, TechniqueInfo};
+use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
-use super::{FrameInputs, Technique, clear_visibility, resolve, surface_inputs};
+use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
+use crate::frame::FrameInputs;
 use crate::geometry::silhouette::{Caster, Mailbox};
 use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
 use crate::gpu::{
@@ -44,59 +46,67 @@ use crate::gpu::{
 pub const SMOOTHIE_SCALE: f64 = 0.3;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
-    offline: false,
     name: "smoothie",
     summary: "Chan & Durand's smoothies: shadow map + silhouette quads with remapped alpha, on every receiver",
-    knobs: &[
-        Knob { default: 1024.0, ..SHADOW_MAP_SIZE },
-        Knob {
-            name: "smoothie_size",
-            default: 1024.0,
-            min: 16.0,
-            max: 16384.0,
-            integer: true,
-            help: "smoothie buffer width and height, in texels",
-        },
-        Knob {
-            name: "t",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: false,
-            help: "smoothie size in the light's tangent units; 0: from the light radius (t_scale R / b)",
-        },
-        Knob {
-            name: "t_scale",
-            default: SMOOTHIE_SCALE,
-            min: 0.0,
-            max: 8.0,
-            integer: false,
-            help: "with t = 0: smoothie size as a multiple of the light's angular radius from the blocker",
-        },
-        Knob {
-            name: "depth16",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "1: the paper's 16-bit float shadow map; 0: 32-bit",
-        },
-        FALLOFF,
-        Knob {
-            name: "gpu_silhouettes",
-            default: 0.0,
-            min: 0.0,
-            max: 1.0,
-            integer: true,
-            help: "1: silhouettes and smoothies in a compute shader, drawn indirectly; 0: on the CPU",
-        },
-    ],
+    kind: Kind::Realtime,
+    knobs: &[MAP_SIZE, SMOOTHIE_SIZE, T, T_SCALE, DEPTH16, FALLOFF, GPU_SILHOUETTES],
+    create: |ctx, _, visibility| Ok(Box::new(Smoothie::new(ctx, visibility)?)),
+    bench: &[&[], &[("t_scale", "1")], &[("depth16", "1")], &[("gpu_silhouettes", "1")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    // Issue 5: the smoothie's map is 1024² by default, so against the hard map at 1024².
+    cost_goal: Some(CostGoal {
+        setting: &[],
+        baseline: &shadow_map::INFO,
+        baseline_setting: &[("shadow_map_size", "1024")],
+        max_ratio: 1.3,
+    }),
+};
+
+/// The paper's map is smaller than the hard shadow map's default.
+const MAP_SIZE: Knob = Knob { default: 1024.0, ..SHADOW_MAP_SIZE };
+const SMOOTHIE_SIZE: Knob = Knob {
+    name: "smoothie_size",
+    default: 1024.0,
+    min: 16.0,
+    max: 16384.0,
+    integer: true,
+    help: "smoothie buffer width and height, in texels",
+};
+const T: Knob = Knob {
+    name: "t",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: false,
+    help: "smoothie size in the light's tangent units; 0: from the light radius (t_scale R / b)",
+};
+const T_SCALE: Knob = Knob {
+    name: "t_scale",
+    default: SMOOTHIE_SCALE,
+    min: 0.0,
+    max: 8.0,
+    integer: false,
+    help: "with t = 0: smoothie size as a multiple of the light's angular radius from the blocker",
+};
+const DEPTH16: Knob = Knob {
+    name: "depth16",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "1: the paper's 16-bit float shadow map; 0: 32-bit",
+};
+const GPU_SILHOUETTES: Knob = Knob {
+    name: "gpu_silhouettes",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "1: silhouettes and smoothies in a compute shader, drawn indirectly; 0: on the CPU",
 };
 
 const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 const ALPHA_FORMAT: vk::Format = vk::Format::R16_UNORM;
-/// Texel biases of the map: the `shadow-map` defaults.
-const BIAS: [f32; 3] = [1.0, 1.0, 1.5];
 
 /// What a caster's silhouette was found from: recomputed only when it changes.
 #[derive(Clone, Debug, PartialEq)]
@@ -220,31 +230,31 @@ impl Technique for Smoothie {
         let Some(frustum) = ShadowMapPass::fit(frame) else {
             return clear_visibility(frame, visibility);
         };
-        let t = params.get("t") as f32;
+        let t = params.get(&T) as f32;
         let smoothie_size = if t > 0.0 {
             SmoothieSize::Fixed(t)
         } else {
-            SmoothieSize::Physical { light_radius: frame.scene.light.radius, scale: params.get("t_scale") as f32 }
+            SmoothieSize::Physical { light_radius: frame.scene.light.radius, scale: params.get(&T_SCALE) as f32 }
         };
         // Smoothies reach t beyond the casters' outline: the map and buffer must cover them.
         let frustum = frustum.grown(smoothie_size.largest_reach(frustum.near, frustum.far));
         let ctx = frame.ctx;
-        let format = if params.get("depth16") == 1.0 { vk::Format::R16_SFLOAT } else { DEPTH_FORMAT };
+        let format = if params.is_on(&DEPTH16) { vk::Format::R16_SFLOAT } else { DEPTH_FORMAT };
         if self.pass.format() != format {
             ctx.wait_idle()?;
             let old = std::mem::replace(&mut self.pass, ShadowMapPass::new(ctx, format)?);
             old.destroy(ctx);
         }
-        let size = params.get("shadow_map_size") as u32;
-        let buffer_size = params.get("smoothie_size") as u32;
+        let size = params.get(&MAP_SIZE) as u32;
+        let buffer_size = params.get(&SMOOTHIE_SIZE) as u32;
         // The ground's height (none: infinitely far below) and the light's, for r in pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
         let light_y = frame.scene.light.position.y;
-        let kernel = Vec4::new(buffer_size as f32, params.get("falloff") as f32, ground, light_y);
-        self.pass.record(frame, &frustum, size, BIAS, kernel)?;
+        let kernel = Vec4::new(buffer_size as f32, params.get(&FALLOFF) as f32, ground, light_y);
+        self.pass.record(frame, &frustum, size, DEFAULT_BIASES, kernel)?;
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
-        let source = if params.get("gpu_silhouettes") == 1.0 {
+        let source = if params.is_on(&GPU_SILHOUETTES) {
             if self.gpu.is_none() {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }

@@ -8,14 +8,14 @@ use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec4};
 
-use super::FrameInputs;
 use crate::error::Result;
+use crate::frame::FrameInputs;
+use crate::frame::interface::SilhouetteParams;
 use crate::geometry::smoothie::SmoothieSize;
 use crate::gpu::{
     Binding, Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, buffer_barrier, dispatch,
     shaders, update_buffer, upload,
 };
-use crate::gpu_types::SilhouetteParams;
 use crate::scene::{Mesh, MeshId};
 
 const GROUP: u32 = 64;

@@ -7,33 +7,38 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use ash::vk;
 
-use super::knobs::{Knob, Params, TechniqueInfo};
-use super::{FrameInputs, Technique};
+use super::Technique;
+use super::knobs::{Knob, Params};
+use super::registry::{Kind, Runs, SweepKnobs, TechniqueInfo};
 use crate::error::Result;
+use crate::frame::{FrameInputs, RAW_VISIBILITY_FORMAT, Surfaces, quantize};
 use crate::gpu::{Context, FRAMES_IN_FLIGHT, PerFrame, Target, copy_to_target};
 use crate::reference::TraceScene;
-use crate::renderer::{RAW_VISIBILITY_FORMAT, Surfaces, quantize};
 
 pub const RAYTRACE: TechniqueInfo = TechniqueInfo {
-    offline: true,
     name: "raytrace",
     summary: "ground truth on the CPU: stratified shadow rays uniform in the light's solid angle",
-    knobs: &[Knob {
-        name: "samples",
-        default: 1024.0,
-        min: 1.0,
-        max: 65536.0,
-        integer: true,
-        help: "shadow rays per pixel",
-    }],
+    kind: Kind::GroundTruth(Runs::Cpu),
+    knobs: &[SAMPLES],
+    create: |_, _, _| Ok(Box::new(Traced::new(Method::Exact))),
+    bench: &[],
+    sweep_knobs: SweepKnobs { short: &[("samples", "64")], long: &[("samples", "64")], huge: &[("samples", "4")] },
+    cost_goal: None,
 };
 
 pub const PARKER: TechniqueInfo = TechniqueInfo {
-    offline: true,
     name: "parker",
     summary: "Parker, Shirley & Smits: one shadow ray per pixel past soft-edged occluders (CPU)",
+    kind: Kind::CpuApproximation,
     knobs: &[],
+    create: |_, _, _| Ok(Box::new(Traced::new(Method::Parker))),
+    bench: &[],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    cost_goal: None,
 };
+
+const SAMPLES: Knob =
+    Knob { name: "samples", default: 1024.0, min: 1.0, max: 65536.0, integer: true, help: "shadow rays per pixel" };
 
 /// Shadow rays in a frame above which a progress bar is worth showing.
 const LONG_FRAME_RAYS: usize = 20_000_000;
@@ -63,7 +68,7 @@ impl Technique for Traced {
         let (w, h) = (extent.width, extent.height);
         let scene = TraceScene::new(frame.scene)?;
         let light = &frame.scene.light;
-        let samples = if self.method == Method::Exact { params.get("samples") as usize } else { 1 };
+        let samples = if self.method == Method::Exact { params.get(&SAMPLES) as usize } else { 1 };
 
         // Indicatif hides the bar when stderr is not a terminal.
         let bar = (w as usize * h as usize * samples > LONG_FRAME_RAYS)

@@ -4,7 +4,7 @@
 
 use softshadow::gpu::ContextOptions;
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, knobs};
+use softshadow::technique::{Params, find};
 use softshadow::{Capture, Engine, FrameSettings};
 
 pub fn engine() -> Engine {
@@ -93,7 +93,7 @@ pub fn wall_edge_width(c: &Capture, x: u32) -> usize {
 /// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
 pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
     let mut frame = settings(s, size, size);
-    frame.params = Params::defaults(knobs::find(technique).expect("a known technique"));
+    frame.params = Params::defaults(find(technique).expect("a known technique"));
     frame.params.apply(sets.iter().copied()).expect("valid knobs");
     e.render_and_capture(s, &frame).expect("a rendered frame")
 }
