@@ -58,14 +58,15 @@ fn main() {
         match compiler.compile_into_spirv(&source, kind, &name, "main", Some(&options)) {
             Ok(artifact) => {
                 let ident = const_name(&glsl, path);
-                write!(generated, "/// SPIR-V of `{}`.\npub static {ident}: &[u32] = &[", rel(&root, path)).unwrap();
+                let source = rel(&glsl, path);
+                write!(generated, "/// `glsl/{source}`.\npub static {ident}: Shader = Shader {{\n    path: \"{source}\",\n    words: &[").unwrap();
                 for (i, word) in artifact.as_binary().iter().enumerate() {
                     if i % 8 == 0 {
                         generated.push_str("\n    ");
                     }
                     write!(generated, "0x{word:08x}, ").unwrap();
                 }
-                generated.push_str("\n];\n\n");
+                generated.push_str("\n    ],\n};\n\n");
             }
             Err(e) => failures.push(format!("{}:\n{e}", rel(&root, path))),
         }

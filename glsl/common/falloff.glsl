@@ -3,6 +3,10 @@
 #ifndef SOFTSHADOW_FALLOFF_GLSL
 #define SOFTSHADOW_FALLOFF_GLSL
 
+// The `falloff` knob: which row a resolve reads. Shaders including this file leave
+// constant_id 8 to it.
+layout(constant_id = 8) const int FALLOFF = 0;
+
 float falloff_at(sampler2D curves, int row, float t) {
     float x = clamp(t, 0.0, 1.0) * 255.0;
     int i = int(floor(x));

@@ -1,4 +1,4 @@
-// Structs that cross to the GPU. Mirrored one-to-one by `src/gpu_types.rs` (#[repr(C)], std140
+// Structs that cross to the GPU. Mirrored one-to-one by `src/frame/interface.rs` (#[repr(C)], std140
 // and std430 compatible: only vec4 and mat4 members); keep the two in step.
 #ifndef SOFTSHADOW_INTERFACE_GLSL
 #define SOFTSHADOW_INTERFACE_GLSL
@@ -29,9 +29,9 @@ struct LightView {
     mat4 view_proj;  // world -> light clip
     vec4 extent;     // tangent-space window: x0, y0, x1, y1 (x/z and y/z of the frustum's sides)
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
-    vec4 kernel;     // PCF: taps, kernel radius, 1 = radius in world units (0 = texels), unused
+    vec4 kernel;     // PCF: taps, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
                      // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
-                     // smoothie: buffer size, falloff row, ground height, light height
+                     // smoothie: buffer size, unused, ground height, light height
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the
@@ -46,8 +46,8 @@ struct LightSample {
 struct PlateauView {
     mat4 umbra;         // world -> plateau clip: window * plane coordinates * Blinn, z = 0 (hither)
     vec4 plane_origin;  // xyz; w = how far off the plane a surface may be and still be on it
-    vec4 plane_normal;  // xyz; w = off-plane receivers: 0 unshadowed, 1 projected light map
-    vec4 plane_u;       // xyz; w = falloff row: 0 linear, 1 sine, 2 smoothstep
+    vec4 plane_normal;  // xyz; w unused
+    vec4 plane_u;       // xyz; w unused
     vec4 plane_v;       // xyz
     vec4 window;        // u0, v0, u1, v1: the part of the plane the texture covers
 };
@@ -56,7 +56,7 @@ struct PlateauView {
 // them can be bound one element at a time as a uniform buffer.
 struct SilhouetteParams {
     mat4 model_view;  // object -> light view (+z away from the light)
-    vec4 size;        // x: t, or scale * light radius when y = 1 (t = x / depth); z: farthest receiver
+    vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver
     uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices
     vec4 pad[10];
 };

@@ -5,6 +5,10 @@
 #include "camera.glsl"
 #include "falloff.glsl"
 
+// The `off_plane` knob: receivers off the plane read the projected light map (§2), or are
+// unshadowed.
+layout(constant_id = 0) const bool OFF_PLANE_MAP = false;
+
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
 layout(set = 0, binding = 2) uniform sampler2D camera_depth;
@@ -44,7 +48,7 @@ void main() {
         // Off the plane: unshadowed, or (mode 1, receivers that cast nothing) the paper's
         // projected light map: the texture where the ray from the light through p meets the plane.
         float hl = dot(frame.light.xyz - o, n);
-        if (plateau.plane_normal.w < 0.5 || s.casts || h >= hl) {
+        if (!OFF_PLANE_MAP || s.casts || h >= hl) {
             out_visibility = 1.0;
             return;
         }
@@ -56,5 +60,5 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    out_visibility = falloff_at(falloff, int(plateau.plane_u.w), plateau_t(tc));
+    out_visibility = falloff_at(falloff, FALLOFF, plateau_t(tc));
 }

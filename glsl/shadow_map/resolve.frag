@@ -11,6 +11,8 @@ const int DISK = 1;    // pcf: rotated Vogel disk
 const int BICUBIC = 2; // pcf: 4x4 B-spline
 const int PCSS = 3;    // pcss: blocker search, penumbra estimate, PCF
 layout(constant_id = 0) const int FILTER = HARD;
+// pcf's `radius_world`: the disk radius is in world units at the receiver, not texels.
+layout(constant_id = 1) const bool RADIUS_IN_WORLD = false;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Light { LightView light; };
@@ -41,7 +43,7 @@ void main() {
         out_visibility = compare_bilinear(shadow_map, vec2(0.0), size, l.uv, l.depth);
     } else if (FILTER == DISK) {
         float radius = light.kernel.y;
-        if (light.kernel.z > 0.5) {
+        if (RADIUS_IN_WORLD) {
             // World units: divide by the world size of one texel at the receiver.
             float z = (light.view * vec4(s.p, 1.0)).z;
             radius *= texels_per_tangent(light).x / z;

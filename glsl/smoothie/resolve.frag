@@ -54,5 +54,5 @@ void main() {
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
     // falloff texture.
     float v = umbra > 0.0 ? min(umbra, smoothie_test(l.uv, l.depth)) : 0.0;
-    out_visibility = v > 0.0 && v < 1.0 ? falloff_at(falloff, int(light.kernel.y), v) : v;
+    out_visibility = v > 0.0 && v < 1.0 ? falloff_at(falloff, FALLOFF, v) : v;
 }

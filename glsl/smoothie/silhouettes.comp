@@ -9,6 +9,9 @@ layout(local_size_x = 64) in;
 const uint NO_FACE = 0xffffffffu;
 const float MIN_DEPTH = 1e-6;
 
+// Smoothie size from the light's angular radius at the blocker (t = scale · R / b), or fixed.
+layout(constant_id = 0) const bool PHYSICAL_SIZE = true;
+
 layout(set = 0, binding = 0) uniform Params { SilhouetteParams params; };
 layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
@@ -32,7 +35,7 @@ bool lit(uint face) {
 }
 
 float smoothie_t(float depth) {
-    return params.size.y > 0.5 ? params.size.x / depth : params.size.x;
+    return PHYSICAL_SIZE ? params.size.x / depth : params.size.x;
 }
 
 float reach(float depth) {

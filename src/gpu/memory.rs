@@ -97,6 +97,23 @@ impl PerFrame {
         Ok(PerFrame { buffer, stride })
     }
 
+    /// Keeps `slot` able to hold `bytes` per frame: grown (to a power of two) only when too
+    /// small. Growing waits for the GPU, since the old buffer may be read by a frame in flight.
+    pub fn ensure<'a>(
+        ctx: &Context,
+        slot: &'a mut Option<PerFrame>,
+        name: &str,
+        bytes: u64,
+        usage: vk::BufferUsageFlags,
+    ) -> Result<&'a mut PerFrame> {
+        if slot.as_ref().is_none_or(|b| b.capacity() < bytes) {
+            ctx.wait_idle()?;
+            slot.take().into_iter().for_each(|b| b.destroy(ctx));
+            *slot = Some(PerFrame::new(ctx, name, bytes.next_power_of_two(), super::FRAMES_IN_FLIGHT, usage)?);
+        }
+        Ok(slot.as_mut().expect("just ensured"))
+    }
+
     /// Bytes each frame's copy can hold.
     pub fn capacity(&self) -> u64 {
         self.stride

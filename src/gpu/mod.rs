@@ -5,8 +5,10 @@ mod barrier;
 mod context;
 mod debug;
 mod frames;
+mod guard;
 mod memory;
 mod pipeline;
+pub mod reflect;
 mod render;
 pub mod shaders;
 mod target;
@@ -16,8 +18,10 @@ mod upload;
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
 pub use context::{Context, ContextOptions, DeviceInfo};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
+pub use guard::{Destroy, Guard};
 pub use memory::{Buffer, PerFrame};
-pub use pipeline::{Binding, Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, VertexInput};
+pub use pipeline::{Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, Variants, VertexInput};
+pub use reflect::Binding;
 pub use render::{
     Attachment, RenderPass, dispatch, draw_indexed, draw_indirect, draw_vertices, fullscreen, update_buffer,
 };

@@ -1,30 +1,15 @@
-//! Graphics pipelines for dynamic rendering, each with one push-descriptor set: a pass pushes
-//! its inputs when it records, so no descriptor pools or set lifetimes exist.
+//! Graphics and compute pipelines for dynamic rendering, each with one push-descriptor set: a
+//! pass pushes its inputs when it records, so no descriptor pools or set lifetimes exist. The
+//! set's layout and the specialization constants come from the shaders' SPIR-V
+//! ([`reflect`](super::reflect)); what a call site binds is checked against it.
 
 use ash::vk;
 
 use super::Context;
+use super::reflect::{Binding, DeclaredBinding, Reflection, reflect};
+use super::shaders::{self, Shader};
 use super::target::Target;
 use crate::error::{Error, Result, VkContext};
-
-/// What a binding of set 0 holds; bindings are numbered in the order given.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Binding {
-    Uniform,
-    Storage,
-    /// A target read through the context's nearest clamp sampler.
-    Sampled,
-}
-
-impl Binding {
-    fn ty(self) -> vk::DescriptorType {
-        match self {
-            Binding::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
-            Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
-            Binding::Sampled => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-        }
-    }
-}
 
 /// A pass input, in binding order.
 #[derive(Clone, Copy)]
@@ -63,11 +48,25 @@ impl VertexInput {
     }
 }
 
-/// Depth test and write of a pipeline.
+/// Depth test (and write) of a pipeline.
 #[derive(Clone, Copy, Debug)]
 pub struct DepthState {
     pub format: vk::Format,
     pub compare: vk::CompareOp,
+    /// Off for passes that test against depth another pass wrote (shadow volumes).
+    pub write: bool,
+}
+
+impl DepthState {
+    /// Tests with `compare` and writes what passes.
+    pub fn test_write(format: vk::Format, compare: vk::CompareOp) -> Self {
+        DepthState { format, compare, write: true }
+    }
+
+    /// Tests with `compare`, leaves the depth as it is.
+    pub fn test_only(format: vk::Format, compare: vk::CompareOp) -> Self {
+        DepthState { format, compare, write: false }
+    }
 }
 
 /// How fragment outputs combine with what a color target holds.
@@ -81,44 +80,99 @@ pub enum Blend {
     Min,
 }
 
-/// A graphics pipeline's description.
+/// A graphics pipeline's description, declared with a named constructor and refined by
+/// builder methods (kajiya's `ImageDesc`): full-screen-free defaults are no vertex input, no
+/// color or depth target, two-sided, all channels written, no blending.
+#[derive(Clone, Copy)]
 pub struct PipelineDesc<'a> {
     pub name: &'static str,
-    pub vertex: &'a [u32],
-    pub fragment: &'a [u32],
-    /// Bindings of set 0, with the stages that read them.
-    pub bindings: &'a [(Binding, vk::ShaderStageFlags)],
+    pub vertex: &'a Shader,
+    pub fragment: &'a Shader,
     pub vertex_input: VertexInput,
     pub color_formats: &'a [vk::Format],
     pub depth: Option<DepthState>,
+    /// Front and back stencil state (two-sided stencil); the depth format must have stencil.
+    pub stencil: Option<(vk::StencilOpState, vk::StencilOpState)>,
+    /// Two-sided by default: plates and open meshes have no inside to cull.
+    pub cull: vk::CullModeFlags,
+    pub color_write: vk::ColorComponentFlags,
     /// Applied to every color target.
     pub blend: Blend,
-    /// Fragment-shader specialization constants: `constant_id = i` takes `constants[i]`.
-    pub constants: &'a [u32],
+    /// Specialization constants by the name the shaders give them.
+    pub constants: &'a [(&'static str, u32)],
 }
 
-/// A full-screen pass: its fragment shader reads `bindings` and writes one color target.
+impl<'a> PipelineDesc<'a> {
+    pub fn new(name: &'static str, vertex: &'a Shader, fragment: &'a Shader) -> Self {
+        PipelineDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input: VertexInput::None,
+            color_formats: &[],
+            depth: None,
+            stencil: None,
+            cull: vk::CullModeFlags::NONE,
+            color_write: vk::ColorComponentFlags::RGBA,
+            blend: Blend::None,
+            constants: &[],
+        }
+    }
+
+    pub fn vertex_input(self, vertex_input: VertexInput) -> Self {
+        PipelineDesc { vertex_input, ..self }
+    }
+
+    pub fn colors(self, color_formats: &'a [vk::Format]) -> Self {
+        PipelineDesc { color_formats, ..self }
+    }
+
+    pub fn depth(self, depth: DepthState) -> Self {
+        PipelineDesc { depth: Some(depth), ..self }
+    }
+
+    pub fn stencil(self, front: vk::StencilOpState, back: vk::StencilOpState) -> Self {
+        PipelineDesc { stencil: Some((front, back)), ..self }
+    }
+
+    pub fn cull(self, cull: vk::CullModeFlags) -> Self {
+        PipelineDesc { cull, ..self }
+    }
+
+    pub fn color_write(self, color_write: vk::ColorComponentFlags) -> Self {
+        PipelineDesc { color_write, ..self }
+    }
+
+    pub fn blend(self, blend: Blend) -> Self {
+        PipelineDesc { blend, ..self }
+    }
+
+    pub fn constants(self, constants: &'a [(&'static str, u32)]) -> Self {
+        PipelineDesc { constants, ..self }
+    }
+}
+
+/// A full-screen pass: its fragment shader reads its bindings and writes one color target.
 pub struct Fullscreen<'a> {
     pub name: &'static str,
-    pub fragment: &'a [u32],
-    pub bindings: &'a [Binding],
+    pub fragment: &'a Shader,
     pub format: vk::Format,
     pub blend: Blend,
-    pub constants: &'a [u32],
+    pub constants: &'a [(&'static str, u32)],
 }
 
 impl<'a> Fullscreen<'a> {
     /// Overwrites the target, no specialization.
-    pub fn new(name: &'static str, fragment: &'a [u32], bindings: &'a [Binding], format: vk::Format) -> Self {
-        Fullscreen { name, fragment, bindings, format, blend: Blend::None, constants: &[] }
+    pub fn new(name: &'static str, fragment: &'a Shader, format: vk::Format) -> Self {
+        Fullscreen { name, fragment, format, blend: Blend::None, constants: &[] }
     }
 
     pub fn blend(self, blend: Blend) -> Self {
         Fullscreen { blend, ..self }
     }
 
-    /// Specialization constants, in `constant_id` order.
-    pub fn constants(self, constants: &'a [u32]) -> Self {
+    /// Specialization constants by name.
+    pub fn constants(self, constants: &'a [(&'static str, u32)]) -> Self {
         Fullscreen { constants, ..self }
     }
 }
@@ -129,15 +183,34 @@ pub struct Pipeline {
     pub(crate) pipeline: vk::Pipeline,
     layout: vk::PipelineLayout,
     set_layout: vk::DescriptorSetLayout,
-    bindings: Vec<Binding>,
+    /// Set 0 as the shaders declare it, by binding number; the shaders' paths, for messages.
+    bindings: Vec<DeclaredBinding>,
+    shaders: String,
     bind_point: vk::PipelineBindPoint,
+}
+
+/// One stage's shader, what it declares, and the stage flag.
+struct Stage<'a> {
+    shader: &'a Shader,
+    reflection: Reflection,
+    flag: vk::ShaderStageFlags,
+}
+
+impl<'a> Stage<'a> {
+    fn new(shader: &'a Shader, flag: vk::ShaderStageFlags) -> Result<Self> {
+        Ok(Stage { shader, reflection: reflect(shader.path, shader.words)?, flag })
+    }
 }
 
 impl Pipeline {
     pub fn new(ctx: &Context, desc: &PipelineDesc<'_>) -> Result<Self> {
-        let mut pipeline = Pipeline::with_set_layout(ctx, desc.name, desc.bindings, vk::PipelineBindPoint::GRAPHICS)?;
+        let stages = [
+            Stage::new(desc.vertex, vk::ShaderStageFlags::VERTEX)?,
+            Stage::new(desc.fragment, vk::ShaderStageFlags::FRAGMENT)?,
+        ];
+        let mut pipeline = Pipeline::with_set_layout(ctx, desc.name, &stages, vk::PipelineBindPoint::GRAPHICS)?;
         // On failure, `destroy` releases what was made so far (null handles are ignored).
-        if let Err(e) = pipeline.build(ctx, desc) {
+        if let Err(e) = pipeline.build(ctx, desc, &stages) {
             pipeline.destroy(ctx);
             return Err(e);
         }
@@ -145,20 +218,25 @@ impl Pipeline {
         Ok(pipeline)
     }
 
-    /// A compute pipeline whose shader reads and writes `bindings`.
-    pub fn compute(ctx: &Context, name: &'static str, shader: &[u32], bindings: &[Binding]) -> Result<Self> {
-        let bindings: Vec<_> = bindings.iter().map(|b| (*b, vk::ShaderStageFlags::COMPUTE)).collect();
-        let mut pipeline = Pipeline::with_set_layout(ctx, name, &bindings, vk::PipelineBindPoint::COMPUTE)?;
+    /// A compute pipeline running `shader`, specialized by `constants`.
+    pub fn compute(
+        ctx: &Context,
+        name: &'static str,
+        shader: &Shader,
+        constants: &[(&'static str, u32)],
+    ) -> Result<Self> {
+        let stages = [Stage::new(shader, vk::ShaderStageFlags::COMPUTE)?];
+        let mut pipeline = Pipeline::with_set_layout(ctx, name, &stages, vk::PipelineBindPoint::COMPUTE)?;
         let built = (|| {
-            let set_layouts = [pipeline.set_layout];
-            let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-            pipeline.layout =
-                unsafe { ctx.device.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")?;
-            let module = shader_module(ctx, shader)?;
+            let specializations = specializations(name, &stages, constants)?;
+            let info = specialization_info(&specializations[0]);
+            pipeline.layout = pipeline_layout(ctx, pipeline.set_layout)?;
+            let module = shader_module(ctx, shader.words)?;
             let stage = vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::COMPUTE)
                 .module(module)
-                .name(c"main");
+                .name(c"main")
+                .specialization_info(&info);
             let ci = vk::ComputePipelineCreateInfo::default().stage(stage).layout(pipeline.layout);
             let created = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[ci], None) };
             unsafe { ctx.device.destroy_shader_module(module, None) };
@@ -174,86 +252,101 @@ impl Pipeline {
         Ok(pipeline)
     }
 
-    /// The pipeline shell: its push-descriptor set layout, no layout or pipeline yet.
+    /// The pipeline shell: its push-descriptor set layout, the union of what `stages` declare
+    /// (a binding two stages declare must hold the same kind), no layout or pipeline yet.
     fn with_set_layout(
         ctx: &Context,
         name: &'static str,
-        bindings: &[(Binding, vk::ShaderStageFlags)],
+        stages: &[Stage<'_>],
         bind_point: vk::PipelineBindPoint,
     ) -> Result<Self> {
-        let d = &ctx.device;
+        let shaders = stages.iter().map(|s| s.shader.path).collect::<Vec<_>>().join(" + ");
+        let mut bindings: Vec<(DeclaredBinding, vk::ShaderStageFlags)> = Vec::new();
+        for stage in stages {
+            for b in &stage.reflection.bindings {
+                match bindings.iter_mut().find(|(d, _)| d.binding == b.binding) {
+                    Some((d, _)) if d.kind != b.kind => {
+                        return Err(Error::Invalid(format!(
+                            "pipeline `{name}` ({shaders}): binding {} is {:?} `{}` in one stage and {:?} `{}` in {}",
+                            b.binding, d.kind, d.name, b.kind, b.name, stage.shader.path
+                        )));
+                    }
+                    Some((_, flags)) => *flags |= stage.flag,
+                    None => bindings.push((b.clone(), stage.flag)),
+                }
+            }
+        }
+        bindings.sort_by_key(|(b, _)| b.binding);
         let samplers = [ctx.nearest_sampler];
         let layout_bindings: Vec<_> = bindings
             .iter()
-            .enumerate()
-            .map(|(i, (b, stages))| {
+            .map(|(b, stages)| {
                 let binding = vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(b.ty())
+                    .binding(b.binding)
+                    .descriptor_type(descriptor_type(b.kind))
                     .descriptor_count(1)
                     .stage_flags(*stages);
-                if *b == Binding::Sampled { binding.immutable_samplers(&samplers) } else { binding }
+                if b.kind == Binding::Sampled { binding.immutable_samplers(&samplers) } else { binding }
             })
             .collect();
         let set_ci = vk::DescriptorSetLayoutCreateInfo::default()
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&layout_bindings);
-        let set_layout = unsafe { d.create_descriptor_set_layout(&set_ci, None) }.vk("vkCreateDescriptorSetLayout")?;
+        let set_layout =
+            unsafe { ctx.device.create_descriptor_set_layout(&set_ci, None) }.vk("vkCreateDescriptorSetLayout")?;
         Ok(Pipeline {
             name,
             pipeline: vk::Pipeline::null(),
             layout: vk::PipelineLayout::null(),
             set_layout,
-            bindings: bindings.iter().map(|(b, _)| *b).collect(),
+            bindings: bindings.into_iter().map(|(b, _)| b).collect(),
+            shaders,
             bind_point,
         })
     }
 
     /// A full-screen pass (`glsl/common/fullscreen.vert`) as `desc` describes it.
     pub fn fullscreen(ctx: &Context, desc: &Fullscreen<'_>) -> Result<Self> {
-        let bindings: Vec<_> = desc.bindings.iter().map(|b| (*b, vk::ShaderStageFlags::FRAGMENT)).collect();
-        Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: desc.name,
-                vertex: super::shaders::COMMON_FULLSCREEN_VERT,
-                fragment: desc.fragment,
-                bindings: &bindings,
-                vertex_input: VertexInput::None,
-                color_formats: &[desc.format],
-                depth: None,
-                blend: desc.blend,
-                constants: desc.constants,
-            },
-        )
+        let formats = [desc.format];
+        let pipeline = PipelineDesc::new(desc.name, &shaders::COMMON_FULLSCREEN_VERT, desc.fragment)
+            .colors(&formats)
+            .blend(desc.blend)
+            .constants(desc.constants);
+        Pipeline::new(ctx, &pipeline)
     }
 
-    fn build(&mut self, ctx: &Context, desc: &PipelineDesc<'_>) -> Result<()> {
+    fn build(&mut self, ctx: &Context, desc: &PipelineDesc<'_>, stages: &[Stage<'_>; 2]) -> Result<()> {
         let d = &ctx.device;
-        let set_layouts = [self.set_layout];
-        let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-        self.layout = unsafe { d.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")?;
+        let specializations = specializations(desc.name, stages, desc.constants)?;
+        let [vert_info, frag_info] = [0, 1].map(|i| specialization_info(&specializations[i]));
+        let has_stencil = desc.depth.is_some_and(|s| format_has_stencil(s.format));
+        if desc.stencil.is_some() && !has_stencil {
+            return Err(Error::Invalid(format!(
+                "pipeline `{}`: stencil state needs a depth-stencil format",
+                desc.name
+            )));
+        }
+        self.layout = pipeline_layout(ctx, self.set_layout)?;
 
-        let vert = shader_module(ctx, desc.vertex)?;
-        let frag = match shader_module(ctx, desc.fragment) {
+        let vert = shader_module(ctx, desc.vertex.words)?;
+        let frag = match shader_module(ctx, desc.fragment.words) {
             Ok(f) => f,
             Err(e) => {
                 unsafe { d.destroy_shader_module(vert, None) };
                 return Err(e);
             }
         };
-        let entries: Vec<_> = (0..desc.constants.len() as u32)
-            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
-            .collect();
-        let specialization =
-            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(desc.constants));
-        let stages = [
-            vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
+        let stage_infos = [
+            vk::PipelineShaderStageCreateInfo::default()
+                .stage(vk::ShaderStageFlags::VERTEX)
+                .module(vert)
+                .name(c"main")
+                .specialization_info(&vert_info),
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::FRAGMENT)
                 .module(frag)
                 .name(c"main")
-                .specialization_info(&specialization),
+                .specialization_info(&frag_info),
         ];
         let (stride, attributes) = desc.vertex_input.layout();
         let vb = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
@@ -278,24 +371,27 @@ impl Pipeline {
         let assembly =
             vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-        // Two-sided everywhere: plates and open meshes have no inside to cull.
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
-            .cull_mode(vk::CullModeFlags::NONE)
+            .cull_mode(desc.cull)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         let multisample =
             vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let (front, back) = desc.stencil.unwrap_or_default();
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth.is_some())
-            .depth_write_enable(desc.depth.is_some())
-            .depth_compare_op(desc.depth.map_or(vk::CompareOp::ALWAYS, |d| d.compare));
+            .depth_write_enable(desc.depth.is_some_and(|d| d.write))
+            .depth_compare_op(desc.depth.map_or(vk::CompareOp::ALWAYS, |d| d.compare))
+            .stencil_test_enable(desc.stencil.is_some())
+            .front(front)
+            .back(back);
         let op = match desc.blend {
             Blend::None | Blend::Add => vk::BlendOp::ADD,
             Blend::Min => vk::BlendOp::MIN,
         };
         let attachment = vk::PipelineColorBlendAttachmentState::default()
-            .color_write_mask(vk::ColorComponentFlags::RGBA)
+            .color_write_mask(desc.color_write)
             .blend_enable(desc.blend != Blend::None)
             .src_color_blend_factor(vk::BlendFactor::ONE)
             .dst_color_blend_factor(vk::BlendFactor::ONE)
@@ -309,9 +405,14 @@ impl Pipeline {
         let dynamic_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(desc.color_formats)
-            .depth_attachment_format(desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format));
+            .depth_attachment_format(desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format))
+            .stencil_attachment_format(if has_stencil {
+                desc.depth.map_or(vk::Format::UNDEFINED, |d| d.format)
+            } else {
+                vk::Format::UNDEFINED
+            });
         let ci = vk::GraphicsPipelineCreateInfo::default()
-            .stages(&stages)
+            .stages(&stage_infos)
             .vertex_input_state(&vertex_input)
             .input_assembly_state(&assembly)
             .viewport_state(&viewport)
@@ -331,36 +432,47 @@ impl Pipeline {
         Ok(())
     }
 
-    /// Binds the pipeline and pushes its inputs, which must match the bindings in order.
-    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, inputs: &[Descriptor<'_>]) {
-        assert_eq!(inputs.len(), self.bindings.len(), "{}: wrong number of inputs", self.name);
-        let buffers: Vec<[vk::DescriptorBufferInfo; 1]> = inputs
-            .iter()
-            .map(|i| match i {
-                Descriptor::Buffer(b) => [*b],
-                Descriptor::Image(_) => [vk::DescriptorBufferInfo::default()],
-            })
-            .collect();
-        let images: Vec<[vk::DescriptorImageInfo; 1]> = inputs
-            .iter()
-            .map(|i| match i {
-                Descriptor::Image(t) => [vk::DescriptorImageInfo {
+    /// Binds the pipeline and pushes `inputs`, one per binding the shaders declare, in binding
+    /// order. A count or kind that disagrees with the shaders is an error naming the binding.
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, inputs: &[Descriptor<'_>]) -> Result<()> {
+        let mismatch = |what: String| Error::Invalid(format!("pipeline `{}` ({}): {what}", self.name, self.shaders));
+        if inputs.len() != self.bindings.len() {
+            let declared: Vec<_> = self.bindings.iter().map(|b| format!("{} `{}`", b.binding, b.name)).collect();
+            return Err(mismatch(format!(
+                "{} inputs given, the shaders declare {} bindings ({})",
+                inputs.len(),
+                self.bindings.len(),
+                declared.join(", ")
+            )));
+        }
+        let mut buffers = Vec::with_capacity(inputs.len());
+        let mut images = Vec::with_capacity(inputs.len());
+        for (b, input) in self.bindings.iter().zip(inputs) {
+            match (b.kind, input) {
+                (Binding::Uniform | Binding::Storage, Descriptor::Buffer(info)) => buffers.push([*info]),
+                (Binding::Sampled, Descriptor::Image(t)) => images.push([vk::DescriptorImageInfo {
                     sampler: vk::Sampler::null(),
                     image_view: t.view,
                     image_layout: t.last.layout,
-                }],
-                Descriptor::Buffer(_) => [vk::DescriptorImageInfo::default()],
-            })
-            .collect();
+                }]),
+                (kind, _) => {
+                    let given = if matches!(input, Descriptor::Buffer(_)) { "a buffer" } else { "an image" };
+                    return Err(mismatch(format!("binding {} `{}` is {kind:?}, given {given}", b.binding, b.name)));
+                }
+            }
+        }
+        let (mut next_buffer, mut next_image) = (buffers.iter(), images.iter());
         let writes: Vec<_> = self
             .bindings
             .iter()
-            .enumerate()
-            .map(|(i, b)| {
-                let w = vk::WriteDescriptorSet::default().dst_binding(i as u32).descriptor_type(b.ty());
-                match inputs[i] {
-                    Descriptor::Buffer(_) => w.buffer_info(&buffers[i]),
-                    Descriptor::Image(_) => w.image_info(&images[i]),
+            .map(|b| {
+                let w =
+                    vk::WriteDescriptorSet::default().dst_binding(b.binding).descriptor_type(descriptor_type(b.kind));
+                match b.kind {
+                    Binding::Sampled => w.image_info(next_image.next().expect("one image per sampled binding")),
+                    Binding::Uniform | Binding::Storage => {
+                        w.buffer_info(next_buffer.next().expect("one buffer per buffer binding"))
+                    }
                 }
             })
             .collect();
@@ -368,6 +480,7 @@ impl Pipeline {
             ctx.device.cmd_bind_pipeline(cmd, self.bind_point, self.pipeline);
             ctx.push_descriptor.cmd_push_descriptor_set(cmd, self.bind_point, self.layout, 0, &writes);
         }
+        Ok(())
     }
 
     pub fn destroy(self, ctx: &Context) {
@@ -379,7 +492,129 @@ impl Pipeline {
     }
 }
 
+/// Pipelines of one pass specialized differently (a filter, a falloff curve), made on first
+/// use and kept: switching a knob back and forth costs one compile each way, once.
+pub struct Variants<K> {
+    made: Vec<(K, Pipeline)>,
+}
+
+impl<K> Default for Variants<K> {
+    fn default() -> Self {
+        Variants { made: Vec::new() }
+    }
+}
+
+impl<K: PartialEq> Variants<K> {
+    /// The pipeline for `key`, made by `make` the first time.
+    pub fn get(&mut self, key: K, make: impl FnOnce(&K) -> Result<Pipeline>) -> Result<&Pipeline> {
+        let index = match self.made.iter().position(|(k, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                let pipeline = make(&key)?;
+                self.made.push((key, pipeline));
+                self.made.len() - 1
+            }
+        };
+        Ok(&self.made[index].1)
+    }
+}
+
+impl<K> Variants<K> {
+    pub fn destroy(self, ctx: &Context) {
+        self.made.into_iter().for_each(|(_, p)| p.destroy(ctx));
+    }
+}
+
+fn descriptor_type(kind: Binding) -> vk::DescriptorType {
+    match kind {
+        Binding::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
+        Binding::Storage => vk::DescriptorType::STORAGE_BUFFER,
+        Binding::Sampled => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+    }
+}
+
+fn format_has_stencil(format: vk::Format) -> bool {
+    matches!(format, vk::Format::D32_SFLOAT_S8_UINT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D16_UNORM_S8_UINT)
+}
+
+/// One stage's specialization: map entries and the values they point into.
+type Specialization = (Vec<vk::SpecializationMapEntry>, Vec<u32>);
+
+fn specialization_info((entries, values): &Specialization) -> vk::SpecializationInfo<'_> {
+    vk::SpecializationInfo::default().map_entries(entries).data(bytemuck::cast_slice(values))
+}
+
+/// Each stage's specialization by `constants`' names; a name no stage declares is an error
+/// naming the pipeline and what the shaders do declare.
+fn specializations(name: &str, stages: &[Stage<'_>], constants: &[(&'static str, u32)]) -> Result<Vec<Specialization>> {
+    for (constant, _) in constants {
+        if !stages.iter().any(|s| s.reflection.constants.iter().any(|c| c.name == *constant)) {
+            let declared: Vec<_> =
+                stages.iter().flat_map(|s| s.reflection.constants.iter().map(|c| c.name.as_str())).collect();
+            let shaders: Vec<_> = stages.iter().map(|s| s.shader.path).collect();
+            return Err(Error::Invalid(format!(
+                "pipeline `{name}` ({}): no specialization constant `{constant}` (declared: {})",
+                shaders.join(" + "),
+                if declared.is_empty() { "none".to_string() } else { declared.join(", ") }
+            )));
+        }
+    }
+    Ok(stages
+        .iter()
+        .map(|stage| {
+            stage
+                .reflection
+                .constants
+                .iter()
+                .filter_map(|c| constants.iter().find(|(n, _)| *n == c.name).map(|(_, v)| (c.id, *v)))
+                .enumerate()
+                .map(|(i, (id, v))| (vk::SpecializationMapEntry { constant_id: id, offset: 4 * i as u32, size: 4 }, v))
+                .unzip()
+        })
+        .collect())
+}
+
+fn pipeline_layout(ctx: &Context, set_layout: vk::DescriptorSetLayout) -> Result<vk::PipelineLayout> {
+    let set_layouts = [set_layout];
+    let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+    unsafe { ctx.device.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")
+}
+
 fn shader_module(ctx: &Context, words: &[u32]) -> Result<vk::ShaderModule> {
     let ci = vk::ShaderModuleCreateInfo::default().code(words);
     unsafe { ctx.device.create_shader_module(&ci, None) }.vk("vkCreateShaderModule")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::ContextOptions;
+
+    /// The shaders, not the call site, declare the bindings and constants: a call that
+    /// disagrees is an error naming the shader and the binding or constant.
+    #[test]
+    fn calls_that_disagree_with_the_shaders_are_named_errors() {
+        let ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
+        let resolve = &shaders::SHADOW_MAP_RESOLVE_FRAG;
+        let constants = [("FILTRE", 1)];
+        let typo = Fullscreen::new("resolve", resolve, vk::Format::R16_UNORM).constants(&constants);
+        let e = Pipeline::fullscreen(&ctx, &typo).err().expect("no such constant").to_string();
+        assert!(e.contains("FILTRE") && e.contains("FILTER") && e.contains("shadow_map/resolve.frag"), "{e}");
+
+        let pipeline = Pipeline::fullscreen(&ctx, &Fullscreen::new("resolve", resolve, vk::Format::R16_UNORM)).unwrap();
+        let pool_ci = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
+        let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.unwrap();
+        let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
+        let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }.unwrap()[0];
+        let buffer = Descriptor::Buffer(vk::DescriptorBufferInfo::default());
+        let e = pipeline.bind(&ctx, cmd, &[buffer; 4]).unwrap_err().to_string();
+        assert!(e.contains("4 inputs") && e.contains("5 bindings") && e.contains("shadow_map"), "{e}");
+        let e = pipeline.bind(&ctx, cmd, &[buffer; 5]).unwrap_err().to_string();
+        assert!(e.contains("binding 2 `camera_depth`") && e.contains("given a buffer"), "{e}");
+        unsafe { ctx.device.destroy_command_pool(pool, None) };
+        pipeline.destroy(&ctx);
+        let mut ctx = ctx;
+        ctx.destroy();
+        assert!(ctx.validation_errors().is_empty(), "{:?}", ctx.validation_errors());
+    }
 }

@@ -5,6 +5,7 @@ use ash::vk;
 use super::Context;
 use super::pipeline::{Descriptor, Pipeline};
 use super::target::Target;
+use crate::error::Result;
 
 /// A target drawn into, cleared first or loaded.
 pub struct Attachment<'a> {
@@ -101,11 +102,14 @@ pub fn fullscreen(
     pipeline: &Pipeline,
     target: &Target,
     inputs: &[Descriptor<'_>],
-) {
+) -> Result<()> {
     let pass = RenderPass::begin(ctx, cmd, &[Attachment { target, clear: None }], None);
-    pipeline.bind(ctx, cmd, inputs);
-    unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+    let bound = pipeline.bind(ctx, cmd, inputs);
+    if bound.is_ok() {
+        unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+    }
     pass.end(ctx, cmd);
+    bound
 }
 
 /// Draws `count` vertices of the tightly packed vertex buffer range `vertices` from `first`

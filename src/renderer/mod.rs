@@ -46,10 +46,10 @@ impl FrameSettings {
     /// unknown technique or a bad knob names the scene file and the line, when it has them.
     pub fn from_scene(scene: &Scene) -> Result<Self> {
         let render = &scene.render;
-        let located = |line: Option<usize>, table: &str, e: crate::Error| match &render.source {
+        let located = |line: Option<usize>, table: &str, e: crate::error::Error| match &render.source {
             Some(path) => {
                 let at = line.map_or_else(String::new, |l| format!("line {l}: "));
-                crate::Error::scene(path, format!("{at}[{table}] {e}"))
+                crate::error::Error::scene(path, format!("{at}[{table}] {e}"))
             }
             None => e,
         };
@@ -323,17 +323,8 @@ impl Engine {
             objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, ShadowRole::Receives));
         }
         let bytes: &[u8] = cast_slice(&objects);
-        if self.objects.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
-            // Grows only; the old buffer may still be read by the frame in flight.
-            ctx.wait_idle()?;
-            if let Some(old) = self.objects.take() {
-                old.destroy(ctx);
-            }
-            let size = (bytes.len() as u64).next_power_of_two();
-            self.objects =
-                Some(PerFrame::new(ctx, "objects", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::STORAGE_BUFFER)?);
-        }
-        let object_buffer = self.objects.as_mut().expect("ensured");
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let object_buffer = PerFrame::ensure(ctx, &mut self.objects, "objects", bytes.len() as u64, usage)?;
         if !bytes.is_empty() {
             object_buffer.write(frame.slot, bytes);
         }
@@ -361,7 +352,13 @@ impl Engine {
 
         clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
-        self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, [globals_range, objects_range], &draws);
+        self.prepass.as_ref().expect("built").record(
+            ctx,
+            &mut frame,
+            targets,
+            [globals_range, objects_range],
+            &draws,
+        )?;
         clock.mark("prepass");
         let (_, technique) = self.technique.as_mut().expect("ensured");
         let mut inputs = FrameInputs {
@@ -380,7 +377,7 @@ impl Engine {
         };
         technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
         clock.mark("technique");
-        self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range);
+        self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range)?;
         if capture {
             let size = capture::readback_size(w, h, self.visibility_format);
             if self.readback.as_ref().is_none_or(|b| b.size != size) {

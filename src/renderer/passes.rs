@@ -6,8 +6,8 @@ use super::CameraTargets;
 use crate::error::Result;
 use crate::frame::{Draw, MESH_POSITIONS_NORMALS};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc,
-    RenderPass, fullscreen, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc, RenderPass,
+    fullscreen, shaders, transition,
 };
 
 /// Facet normal + shadow role, read by the techniques.
@@ -24,23 +24,12 @@ pub struct Prepass {
 
 impl Prepass {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let vertex = vk::ShaderStageFlags::VERTEX;
-        let both = vertex | vk::ShaderStageFlags::FRAGMENT;
-        let pipeline = Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: "prepass",
-                vertex: shaders::PREPASS_SCENE_VERT,
-                fragment: shaders::PREPASS_SCENE_FRAG,
-                bindings: &[(Binding::Uniform, both), (Binding::Storage, vertex)],
-                vertex_input: MESH_POSITIONS_NORMALS,
-                color_formats: &[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT],
-                // Reverse Z: nearer is greater.
-                depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::GREATER }),
-                blend: Blend::None,
-                constants: &[],
-            },
-        )?;
+        let desc = PipelineDesc::new("prepass", &shaders::PREPASS_SCENE_VERT, &shaders::PREPASS_SCENE_FRAG)
+            .vertex_input(MESH_POSITIONS_NORMALS)
+            .colors(&[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT])
+            // Reverse Z: nearer is greater.
+            .depth(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::GREATER));
+        let pipeline = Pipeline::new(ctx, &desc)?;
         Ok(Prepass { pipeline })
     }
 
@@ -52,7 +41,7 @@ impl Prepass {
         t: &mut CameraTargets,
         inputs: [vk::DescriptorBufferInfo; 2],
         draws: &[Draw],
-    ) {
+    ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "prepass");
         transition(
@@ -75,7 +64,7 @@ impl Prepass {
             ],
             Some(Attachment::clear_depth(&t.depth, 0.0)),
         );
-        self.pipeline.bind(ctx, cmd, &inputs.map(Descriptor::Buffer));
+        self.pipeline.bind(ctx, cmd, &inputs.map(Descriptor::Buffer))?;
         for draw in draws {
             draw.record(ctx, cmd);
         }
@@ -91,6 +80,7 @@ impl Prepass {
             ],
         );
         frame.timer.end(ctx, cmd);
+        Ok(())
     }
 
     pub fn destroy(self, ctx: &Context) {
@@ -105,11 +95,8 @@ pub struct Composite {
 
 impl Composite {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let b = [Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled, Binding::Sampled];
-        let pipeline = Pipeline::fullscreen(
-            ctx,
-            &Fullscreen::new("composite", shaders::COMPOSITE_COMPOSITE_FRAG, &b, COLOR_FORMAT),
-        )?;
+        let pipeline =
+            Pipeline::fullscreen(ctx, &Fullscreen::new("composite", &shaders::COMPOSITE_COMPOSITE_FRAG, COLOR_FORMAT))?;
         Ok(Composite { pipeline })
     }
 
@@ -119,7 +106,7 @@ impl Composite {
         frame: &mut Frame<'_>,
         t: &mut CameraTargets,
         globals: vk::DescriptorBufferInfo,
-    ) {
+    ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "composite");
         transition(
@@ -139,8 +126,9 @@ impl Composite {
                 Descriptor::Image(&t.albedo),
                 Descriptor::Image(&t.visibility),
             ],
-        );
+        )?;
         frame.timer.end(ctx, cmd);
+        Ok(())
     }
 
     pub fn destroy(self, ctx: &Context) {

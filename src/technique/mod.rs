@@ -58,13 +58,14 @@ pub(crate) fn resolve(
     pipeline: &crate::gpu::Pipeline,
     visibility: &mut Target,
     inputs: &[crate::gpu::Descriptor<'_>],
-) {
+) -> Result<()> {
     use crate::gpu::{Access, fullscreen, transition};
     let (ctx, cmd) = (frame.ctx, frame.cmd);
     frame.timer.begin(ctx, cmd, "resolve");
     transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true)]);
-    fullscreen(ctx, cmd, pipeline, visibility, inputs);
+    fullscreen(ctx, cmd, pipeline, visibility, inputs)?;
     frame.timer.end(ctx, cmd);
+    Ok(())
 }
 
 /// Writes V = 1 everywhere: the scene in view has nothing that can shadow a receiver, so no

@@ -40,8 +40,8 @@ use crate::geometry::plateau::{
 };
 use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_vertices, ensure, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame, Pipeline,
+    PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_vertices, ensure, shaders, transition,
 };
 
 /// Cone radius / the true penumbra's half width, physical mode: what measured best against the
@@ -127,7 +127,10 @@ struct SidesKey {
 pub struct Plateau {
     umbra: Pipeline,
     penumbra: Pipeline,
-    resolve: Pipeline,
+    /// Resolve pipelines by falloff curve and off-plane mode.
+    resolves: Variants<(u32, bool)>,
+    /// The V target's format, which the resolves write.
+    visibility: vk::Format,
     view: PerFrame,
     vertices: Option<PerFrame>,
     texture: Option<Target>,
@@ -142,71 +145,25 @@ pub struct Plateau {
 impl Plateau {
     /// `visibility`: the format of the V target the resolve writes.
     pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
-        let vertex = vk::ShaderStageFlags::VERTEX;
-        let depth = Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS });
-        let umbra = Pipeline::new(
-            ctx,
-            &PipelineDesc {
-                name: "umbra",
-                vertex: shaders::PLATEAU_UMBRA_VERT,
-                fragment: shaders::PLATEAU_UMBRA_FRAG,
-                bindings: &[(Binding::Uniform, vertex), (Binding::Storage, vertex)],
-                vertex_input: MESH_POSITIONS,
-                color_formats: &[PLATEAU_FORMAT],
-                depth,
-                blend: Blend::None,
-                constants: &[],
-            },
-        )?;
-        let rest = (|| {
-            let penumbra = Pipeline::new(
-                ctx,
-                &PipelineDesc {
-                    name: "penumbra",
-                    vertex: shaders::PLATEAU_PENUMBRA_VERT,
-                    fragment: shaders::PLATEAU_PENUMBRA_FRAG,
-                    bindings: &[(Binding::Uniform, vertex)],
-                    vertex_input: VertexInput::Floats(&[3]),
-                    color_formats: &[PLATEAU_FORMAT],
-                    depth,
-                    blend: Blend::None,
-                    constants: &[],
-                },
-            )?;
-            let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
-            let bindings = [&b[..], &[Binding::Sampled]].concat();
-            let resolve = Pipeline::fullscreen(
-                ctx,
-                &Fullscreen::new("resolve", shaders::PLATEAU_RESOLVE_FRAG, &bindings, visibility),
-            );
-            let resolve = match resolve {
-                Ok(r) => r,
-                Err(e) => {
-                    penumbra.destroy(ctx);
-                    return Err(e);
-                }
-            };
-            let size = std::mem::size_of::<PlateauView>() as u64;
-            match PerFrame::new(ctx, "plateau view", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER) {
-                Ok(view) => Ok((penumbra, resolve, view)),
-                Err(e) => {
-                    penumbra.destroy(ctx);
-                    resolve.destroy(ctx);
-                    Err(e)
-                }
-            }
-        })();
-        let (penumbra, resolve, view) = match rest {
-            Ok(r) => r,
-            Err(e) => {
-                umbra.destroy(ctx);
-                return Err(e);
-            }
-        };
+        let depth = DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::LESS);
+        let colors = [PLATEAU_FORMAT];
+        let umbra = PipelineDesc::new("umbra", &shaders::PLATEAU_UMBRA_VERT, &shaders::PLATEAU_UMBRA_FRAG)
+            .vertex_input(MESH_POSITIONS)
+            .colors(&colors)
+            .depth(depth);
+        let umbra = Guard::new(ctx, Pipeline::new(ctx, &umbra)?);
+        let penumbra = PipelineDesc::new("penumbra", &shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG)
+            .vertex_input(VertexInput::Floats(&[3]))
+            .colors(&colors)
+            .depth(depth);
+        let penumbra = Guard::new(ctx, Pipeline::new(ctx, &penumbra)?);
+        let size = std::mem::size_of::<PlateauView>() as u64;
+        let view = PerFrame::new(ctx, "plateau view", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?;
         Ok(Plateau {
-            umbra,
-            penumbra,
-            resolve,
+            umbra: umbra.keep(),
+            penumbra: penumbra.keep(),
+            resolves: Variants::default(),
+            visibility,
             view,
             vertices: None,
             texture: None,
@@ -307,8 +264,8 @@ impl Technique for Plateau {
         let view = PlateauView {
             umbra: to_clip * plane.shadow_matrix(light.position),
             plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
-            plane_normal: plane.normal.extend(params.get(&OFF_PLANE) as f32),
-            plane_u: plane.u.extend(params.get(&FALLOFF) as f32),
+            plane_normal: plane.normal.extend(0.0),
+            plane_u: plane.u.extend(0.0),
             plane_v: plane.v.extend(0.0),
             window,
         };
@@ -317,16 +274,10 @@ impl Technique for Plateau {
 
         let vertices: Vec<PlateauVertex> = geometry.cones.iter().chain(&geometry.sheets).copied().collect();
         let bytes: &[u8] = cast_slice(&vertices);
-        if !bytes.is_empty() && self.vertices.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
-            // Grows only; the old buffer may still be read by the frame in flight.
-            ctx.wait_idle()?;
-            self.vertices.take().into_iter().for_each(|b| b.destroy(ctx));
+        if !bytes.is_empty() {
             let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-            let capacity = (bytes.len() as u64).next_power_of_two();
-            self.vertices = Some(PerFrame::new(ctx, "plateau sides", capacity, FRAMES_IN_FLIGHT, usage)?);
-        }
-        if let Some(v) = self.vertices.as_mut().filter(|_| !bytes.is_empty()) {
-            v.write(frame.slot, bytes);
+            PerFrame::ensure(ctx, &mut self.vertices, "plateau sides", bytes.len() as u64, usage)?
+                .write(frame.slot, bytes);
         }
         let cmd = frame.cmd;
         let falloff = self.falloff.texture(ctx, cmd)?;
@@ -341,7 +292,7 @@ impl Technique for Plateau {
             &[Attachment::clear_color(texture, [1.0; 4])],
             Some(Attachment::clear_depth(depth, 1.0)),
         );
-        self.umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)]);
+        self.umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)])?;
         super::shadow_map::draw_casters(frame);
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
@@ -359,7 +310,7 @@ impl Technique for Plateau {
                 Some(Attachment { target: depth, clear: None }),
             );
             if let Some(v) = &self.vertices {
-                self.penumbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range)]);
+                self.penumbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range)])?;
                 draw_vertices(ctx, cmd, v.range(frame.slot), first, count);
             }
             pass.end(ctx, cmd);
@@ -370,15 +321,21 @@ impl Technique for Plateau {
         let inputs =
             [&surface_inputs(frame, view_range)[..], &[Descriptor::Image(texture), Descriptor::Image(falloff)]]
                 .concat();
-        resolve(frame, &self.resolve, visibility, &inputs);
-        Ok(())
+        let format = self.visibility;
+        let key = (params.get(&FALLOFF) as u32, params.is_on(&OFF_PLANE));
+        let pipeline = self.resolves.get(key, |&(curve, off_plane)| {
+            let constants = [("FALLOFF", curve), ("OFF_PLANE_MAP", off_plane as u32)];
+            let desc = Fullscreen::new("resolve", &shaders::PLATEAU_RESOLVE_FRAG, format).constants(&constants);
+            Pipeline::fullscreen(ctx, &desc)
+        })?;
+        resolve(frame, pipeline, visibility, &inputs)
     }
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         let this = *self;
-        for p in [this.umbra, this.penumbra, this.resolve] {
-            p.destroy(ctx);
-        }
+        this.umbra.destroy(ctx);
+        this.penumbra.destroy(ctx);
+        this.resolves.destroy(ctx);
         this.view.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
         this.falloff.destroy(ctx);

@@ -26,7 +26,7 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::{LightSample, LightView};
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Milestones, PerFrame,
+    Access, Attachment, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, Milestones, PerFrame,
     Pipeline, RenderPass, Target, TargetDesc, ensure, shaders, transition,
 };
 
@@ -77,43 +77,22 @@ pub struct Reference {
 impl Reference {
     /// `visibility`: the format of the V target the resolve writes.
     pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
-        let depth = depth_pipeline(ctx, vk::Format::R32_SFLOAT)?;
-        let sampled = Binding::Sampled;
-        let bindings = [Binding::Uniform, Binding::Storage, sampled, sampled, sampled];
-        let accumulate = Pipeline::fullscreen(
-            ctx,
-            &Fullscreen::new("accumulate", shaders::REFERENCE_ACCUMULATE_FRAG, &bindings, SUM_FORMAT).blend(Blend::Add),
-        );
-        let accumulate = match accumulate {
-            Ok(p) => p,
-            Err(e) => {
-                depth.destroy(ctx);
-                return Err(e);
-            }
-        };
-        match Pipeline::fullscreen(
-            ctx,
-            &Fullscreen::new("resolve", shaders::REFERENCE_RESOLVE_FRAG, &[sampled], visibility),
-        ) {
-            Ok(resolve) => {
-                let reference = Reference {
-                    depth,
-                    accumulate,
-                    resolve,
-                    samples: None,
-                    atlas: None,
-                    atlas_depth: None,
-                    sums: None,
-                    milestones: Vec::new(),
-                };
-                Ok(reference)
-            }
-            Err(e) => {
-                depth.destroy(ctx);
-                accumulate.destroy(ctx);
-                Err(e)
-            }
-        }
+        let depth = Guard::new(ctx, depth_pipeline(ctx, vk::Format::R32_SFLOAT)?);
+        let accumulate =
+            Fullscreen::new("accumulate", &shaders::REFERENCE_ACCUMULATE_FRAG, SUM_FORMAT).blend(Blend::Add);
+        let accumulate = Guard::new(ctx, Pipeline::fullscreen(ctx, &accumulate)?);
+        let resolve =
+            Pipeline::fullscreen(ctx, &Fullscreen::new("resolve", &shaders::REFERENCE_RESOLVE_FRAG, visibility))?;
+        Ok(Reference {
+            depth: depth.keep(),
+            accumulate: accumulate.keep(),
+            resolve,
+            samples: None,
+            atlas: None,
+            atlas_depth: None,
+            sums: None,
+            milestones: Vec::new(),
+        })
     }
 
     /// The light samples of this frame, each with its fitted frustum.
@@ -161,14 +140,8 @@ impl Technique for Reference {
         let samples = Self::light_samples(frame, params.get(&SAMPLES) as usize, size);
 
         let bytes = samples.len() as u64 * SAMPLE_BYTES;
-        if self.samples.as_ref().is_none_or(|b| b.capacity() < bytes) {
-            // Grows only; the old buffer may still be read by the frame in flight.
-            ctx.wait_idle()?;
-            self.samples.take().into_iter().for_each(|b| b.destroy(ctx));
-            let usage = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
-            self.samples = Some(PerFrame::new(ctx, "light samples", bytes, FRAMES_IN_FLIGHT, usage)?);
-        }
-        let buffer = self.samples.as_mut().expect("ensured");
+        let usage = vk::BufferUsageFlags::UNIFORM_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+        let buffer = PerFrame::ensure(ctx, &mut self.samples, "light samples", bytes, usage)?;
         buffer.write(frame.slot, cast_slice(&samples));
         let base = buffer.range(frame.slot);
 
@@ -214,7 +187,7 @@ impl Technique for Reference {
                 pass.set_area(ctx, cmd, vk::Rect2D { offset, extent: vk::Extent2D { width: size, height: size } });
                 let light =
                     sub_range(base, first + i as u64 * SAMPLE_BYTES, std::mem::size_of_val(&sample.view) as u64);
-                self.depth.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Buffer(frame.objects)]);
+                self.depth.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Buffer(frame.objects)])?;
                 draw_casters(frame);
             }
             pass.end(ctx, cmd);
@@ -234,7 +207,7 @@ impl Technique for Reference {
                     Descriptor::Image(frame.normal),
                     Descriptor::Image(atlas),
                 ],
-            );
+            )?;
             unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
             pass.end(ctx, cmd);
             milestones.mark(ctx, cmd);
@@ -242,8 +215,7 @@ impl Technique for Reference {
         transition(ctx, cmd, &mut [(sums, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
 
-        resolve(frame, &self.resolve, visibility, &[Descriptor::Image(sums)]);
-        Ok(())
+        resolve(frame, &self.resolve, visibility, &[Descriptor::Image(sums)])
     }
 
     fn progress(&self, ctx: &Context, slot: usize) -> Option<(u32, u32)> {

@@ -21,8 +21,8 @@ use crate::frame::interface::LightView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
 use crate::geometry::{Aabb, LightFrustum, fit_spot_frustum};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, ensure, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, Destroy, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, ensure, shaders, transition,
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -142,23 +142,12 @@ pub(crate) const EMPTY_DEPTH: f32 = f32::MAX;
 /// Renders linear light depth (into `format`: R32 or R16 float) through the `LightView` at
 /// binding 0.
 pub(crate) fn depth_pipeline(ctx: &Context, format: vk::Format) -> Result<Pipeline> {
-    Pipeline::new(
-        ctx,
-        &PipelineDesc {
-            name: "shadow_map",
-            vertex: shaders::SHADOW_MAP_DEPTH_VERT,
-            fragment: shaders::SHADOW_MAP_DEPTH_FRAG,
-            bindings: &[
-                (Binding::Uniform, vk::ShaderStageFlags::VERTEX),
-                (Binding::Storage, vk::ShaderStageFlags::VERTEX),
-            ],
-            vertex_input: MESH_POSITIONS,
-            color_formats: &[format],
-            depth: Some(DepthState { format: vk::Format::D32_SFLOAT, compare: vk::CompareOp::LESS }),
-            blend: Blend::None,
-            constants: &[],
-        },
-    )
+    let formats = [format];
+    let desc = PipelineDesc::new("shadow_map", &shaders::SHADOW_MAP_DEPTH_VERT, &shaders::SHADOW_MAP_DEPTH_FRAG)
+        .vertex_input(MESH_POSITIONS)
+        .colors(&formats)
+        .depth(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::LESS));
+    Pipeline::new(ctx, &desc)
 }
 
 /// Records every caster of the frame (inside a pass whose pipeline is bound).
@@ -180,17 +169,11 @@ pub struct ShadowMapPass {
 impl ShadowMapPass {
     /// A pass rendering into `format` (R32_SFLOAT, or the smoothie paper's R16_SFLOAT).
     pub fn new(ctx: &Context, format: vk::Format) -> Result<Self> {
-        let pipeline = depth_pipeline(ctx, format)?;
+        let pipeline = Guard::new(ctx, depth_pipeline(ctx, format)?);
         let usage = vk::BufferUsageFlags::UNIFORM_BUFFER;
-        let light =
-            match PerFrame::new(ctx, "light view", std::mem::size_of::<LightView>() as u64, FRAMES_IN_FLIGHT, usage) {
-                Ok(l) => l,
-                Err(e) => {
-                    pipeline.destroy(ctx);
-                    return Err(e);
-                }
-            };
-        Ok(ShadowMapPass { format, pipeline, light, map: None, depth: None })
+        let size = std::mem::size_of::<LightView>() as u64;
+        let light = PerFrame::new(ctx, "light view", size, FRAMES_IN_FLIGHT, usage)?;
+        Ok(ShadowMapPass { format, pipeline: pipeline.keep(), light, map: None, depth: None })
     }
 
     pub fn format(&self) -> vk::Format {
@@ -245,7 +228,7 @@ impl ShadowMapPass {
             ctx,
             cmd,
             &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
-        );
+        )?;
         draw_casters(frame);
         pass.end(ctx, cmd);
         transition(ctx, cmd, &mut [(map, Access::FRAGMENT_READ, false)]);
@@ -265,7 +248,7 @@ impl ShadowMapPass {
     }
 }
 
-/// The resolve variants: specialization constant 0 of `glsl/shadow_map/resolve.frag`.
+/// The resolve variants: `FILTER` of `glsl/shadow_map/resolve.frag`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Filter {
     Hard = 0,
@@ -279,8 +262,9 @@ enum Filter {
 pub struct ShadowMap {
     technique: &'static TechniqueInfo,
     pass: ShadowMapPass,
-    /// Resolve pipelines made so far, by filter (a `pcf` knob can switch filters).
-    resolves: Vec<(Filter, Pipeline)>,
+    /// Resolve pipelines made so far, by filter and whether the disk radius is in world units
+    /// (`pcf` knobs switch both).
+    resolves: Variants<(Filter, bool)>,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
 }
@@ -288,7 +272,7 @@ pub struct ShadowMap {
 impl ShadowMap {
     pub fn new(ctx: &Context, technique: &'static TechniqueInfo, visibility: vk::Format) -> Result<Self> {
         let pass = ShadowMapPass::new(ctx, vk::Format::R32_SFLOAT)?;
-        Ok(ShadowMap { technique, pass, resolves: Vec::new(), visibility })
+        Ok(ShadowMap { technique, pass, resolves: Variants::default(), visibility })
     }
 
     /// The registry's constructor of the family.
@@ -296,26 +280,13 @@ impl ShadowMap {
         Ok(Box::new(ShadowMap::new(ctx, technique, visibility)?))
     }
 
-    /// Index in `resolves` of the pipeline for `filter`, made on first use.
-    fn resolve(&mut self, ctx: &Context, filter: Filter) -> Result<usize> {
-        if let Some(i) = self.resolves.iter().position(|(f, _)| *f == filter) {
-            return Ok(i);
-        }
-        let b = [Binding::Uniform, Binding::Uniform, Binding::Sampled, Binding::Sampled, Binding::Sampled];
-        let constants = [filter as u32];
-        let desc =
-            Fullscreen::new("resolve", shaders::SHADOW_MAP_RESOLVE_FRAG, &b, self.visibility).constants(&constants);
-        self.resolves.push((filter, Pipeline::fullscreen(ctx, &desc)?));
-        Ok(self.resolves.len() - 1)
-    }
-
     /// The filter and its `LightView.filter` parameters for this frame's knobs.
     fn filter(&self, params: &Params, frame: &FrameInputs<'_>, frustum: &LightFrustum) -> (Filter, Vec4) {
         match self.technique.name {
             name if name == PCF.name && params.is_on(&BICUBIC) => (Filter::Bicubic, Vec4::ZERO),
             name if name == PCF.name => {
-                let [taps, radius, world] = [TAPS, RADIUS, RADIUS_WORLD].map(|k| params.get(&k) as f32);
-                (Filter::Disk, Vec4::new(taps, radius, world, 0.0))
+                let [taps, radius] = [TAPS, RADIUS].map(|k| params.get(&k) as f32);
+                (Filter::Disk, Vec4::new(taps, radius, 0.0, 0.0))
             }
             name if name == PCSS.name => {
                 let radius = frame.scene.light.radius * params.get(&LIGHT_SIZE_SCALE) as f32;
@@ -337,15 +308,26 @@ impl Technique for ShadowMap {
         let (filter, filter_params) = self.filter(params, frame, &frustum);
         self.pass.record(frame, &frustum, size, bias, filter_params)?;
 
-        let index = self.resolve(frame.ctx, filter)?;
+        let world = self.technique.name == PCF.name && params.is_on(&RADIUS_WORLD);
+        let format = self.visibility;
+        let pipeline = self.resolves.get((filter, world), |&(filter, world)| {
+            let constants = [("FILTER", filter as u32), ("RADIUS_IN_WORLD", world as u32)];
+            let desc = Fullscreen::new("resolve", &shaders::SHADOW_MAP_RESOLVE_FRAG, format).constants(&constants);
+            Pipeline::fullscreen(frame.ctx, &desc)
+        })?;
         let (map, light) = self.pass.inputs(frame.slot);
         let inputs = [&surface_inputs(frame, light)[..], &[Descriptor::Image(map)]].concat();
-        resolve(frame, &self.resolves[index].1, visibility, &inputs);
-        Ok(())
+        resolve(frame, pipeline, visibility, &inputs)
     }
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         self.pass.destroy(ctx);
-        self.resolves.into_iter().for_each(|(_, p)| p.destroy(ctx));
+        self.resolves.destroy(ctx);
+    }
+}
+
+impl Destroy for ShadowMapPass {
+    fn destroy(self, ctx: &Context) {
+        ShadowMapPass::destroy(self, ctx)
     }
 }

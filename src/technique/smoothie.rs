@@ -34,9 +34,8 @@ use crate::frame::FrameInputs;
 use crate::geometry::silhouette::{Caster, Mailbox};
 use crate::geometry::smoothie::{SmoothieGeometry, SmoothieSize, SmoothieVertex, silhouette, smoothies};
 use crate::gpu::{
-    Access, Attachment, Binding, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, PerFrame, Pipeline,
-    PipelineDesc, RenderPass, Target, TargetDesc, VertexInput, draw_indirect, draw_vertices, ensure, shaders,
-    transition,
+    Access, Attachment, Blend, Context, Descriptor, Fullscreen, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
+    Target, TargetDesc, Variants, VertexInput, draw_indirect, draw_vertices, ensure, shaders, transition,
 };
 
 /// t / (R / b) in the physical mode: what measured best against the reference (N = 256, 256²,
@@ -125,7 +124,10 @@ struct CasterSilhouette {
 pub struct Smoothie {
     pass: ShadowMapPass,
     smoothie: Pipeline,
-    resolve: Pipeline,
+    /// Resolve pipelines by falloff curve.
+    resolves: Variants<u32>,
+    /// The V target's format, which the resolves write.
+    visibility: vk::Format,
     vertices: Option<PerFrame>,
     depth: Option<Target>,
     alpha: Option<Target>,
@@ -140,49 +142,18 @@ pub struct Smoothie {
 impl Smoothie {
     /// `visibility`: the format of the V target the resolve writes.
     pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
-        let pass = ShadowMapPass::new(ctx, DEPTH_FORMAT)?;
-        let pipelines = (|| {
-            let smoothie = Pipeline::new(
-                ctx,
-                &PipelineDesc {
-                    name: "smoothie_buffer",
-                    vertex: shaders::SMOOTHIE_SMOOTHIE_VERT,
-                    fragment: shaders::SMOOTHIE_SMOOTHIE_FRAG,
-                    bindings: &[
-                        (Binding::Uniform, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT),
-                        (Binding::Sampled, vk::ShaderStageFlags::FRAGMENT),
-                    ],
-                    vertex_input: VertexInput::Floats(&[3, 2]),
-                    color_formats: &[DEPTH_FORMAT, ALPHA_FORMAT],
-                    depth: None,
-                    blend: Blend::Min,
-                    constants: &[],
-                },
-            )?;
-            let b = [Binding::Uniform, Binding::Uniform];
-            let bindings = [&b[..], &[Binding::Sampled; 6]].concat();
-            match Pipeline::fullscreen(
-                ctx,
-                &Fullscreen::new("resolve", shaders::SMOOTHIE_RESOLVE_FRAG, &bindings, visibility),
-            ) {
-                Ok(resolve) => Ok((smoothie, resolve)),
-                Err(e) => {
-                    smoothie.destroy(ctx);
-                    Err(e)
-                }
-            }
-        })();
-        let (smoothie, resolve) = match pipelines {
-            Ok(p) => p,
-            Err(e) => {
-                pass.destroy(ctx);
-                return Err(e);
-            }
-        };
+        let pass = Guard::new(ctx, ShadowMapPass::new(ctx, DEPTH_FORMAT)?);
+        let desc =
+            PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, &shaders::SMOOTHIE_SMOOTHIE_FRAG)
+                .vertex_input(VertexInput::Floats(&[3, 2]))
+                .colors(&[DEPTH_FORMAT, ALPHA_FORMAT])
+                .blend(Blend::Min);
+        let smoothie = Pipeline::new(ctx, &desc)?;
         Ok(Smoothie {
-            pass,
+            pass: pass.keep(),
             smoothie,
-            resolve,
+            resolves: Variants::default(),
+            visibility,
             vertices: None,
             depth: None,
             alpha: None,
@@ -250,7 +221,7 @@ impl Technique for Smoothie {
         // The ground's height (none: infinitely far below) and the light's, for r in pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
         let light_y = frame.scene.light.position.y;
-        let kernel = Vec4::new(buffer_size as f32, params.get(&FALLOFF) as f32, ground, light_y);
+        let kernel = Vec4::new(buffer_size as f32, 0.0, ground, light_y);
         self.pass.record(frame, &frustum, size, DEFAULT_BIASES, kernel)?;
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
@@ -265,20 +236,13 @@ impl Technique for Smoothie {
             let geometry = self.geometry(frame, &frustum.view, smoothie_size, frustum.far);
             let vertices: Vec<SmoothieVertex> = geometry.edges.iter().chain(&geometry.corners).copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
-            if !bytes.is_empty() && self.vertices.as_ref().is_none_or(|b| b.capacity() < bytes.len() as u64) {
-                // Grows only; the old buffer may still be read by the frame in flight.
-                ctx.wait_idle()?;
-                self.vertices.take().into_iter().for_each(|b| b.destroy(ctx));
-                let capacity = (bytes.len() as u64).next_power_of_two();
+            if bytes.is_empty() {
+                Smoothies::None
+            } else {
                 let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-                self.vertices = Some(PerFrame::new(ctx, "smoothies", capacity, FRAMES_IN_FLIGHT, usage)?);
-            }
-            match self.vertices.as_mut().filter(|_| !bytes.is_empty()) {
-                Some(v) => {
-                    v.write(frame.slot, bytes);
-                    Smoothies::Direct { vertices: v.range(frame.slot), count: vertices.len() as u32 }
-                }
-                None => Smoothies::None,
+                let v = PerFrame::ensure(ctx, &mut self.vertices, "smoothies", bytes.len() as u64, usage)?;
+                v.write(frame.slot, bytes);
+                Smoothies::Direct { vertices: v.range(frame.slot), count: vertices.len() as u32 }
             }
         };
 
@@ -297,7 +261,7 @@ impl Technique for Smoothie {
             &[Attachment::clear_color(depth, [EMPTY_DEPTH; 4]), Attachment::clear_color(alpha, [1.0; 4])],
             None,
         );
-        self.smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)]);
+        self.smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)])?;
         match source {
             Smoothies::Direct { vertices, count } => draw_vertices(ctx, cmd, vertices, 0, count),
             Smoothies::Indirect { vertices, args } => draw_indirect(ctx, cmd, vertices, args),
@@ -313,15 +277,20 @@ impl Technique for Smoothie {
             &[Descriptor::Image(map), Descriptor::Image(depth), Descriptor::Image(alpha), Descriptor::Image(falloff)],
         ]
         .concat();
-        resolve(frame, &self.resolve, visibility, &inputs);
-        Ok(())
+        let format = self.visibility;
+        let pipeline = self.resolves.get(params.get(&FALLOFF) as u32, |&curve| {
+            let constants = [("FALLOFF", curve)];
+            let desc = Fullscreen::new("resolve", &shaders::SMOOTHIE_RESOLVE_FRAG, format).constants(&constants);
+            Pipeline::fullscreen(ctx, &desc)
+        })?;
+        resolve(frame, pipeline, visibility, &inputs)
     }
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         let this = *self;
         this.pass.destroy(ctx);
         this.smoothie.destroy(ctx);
-        this.resolve.destroy(ctx);
+        this.resolves.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
         this.depth.into_iter().chain(this.alpha).for_each(|t| t.destroy(ctx));
         this.falloff.destroy(ctx);

@@ -13,8 +13,8 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::smoothie::SmoothieSize;
 use crate::gpu::{
-    Binding, Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, buffer_barrier, dispatch,
-    shaders, update_buffer, upload,
+    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Variants, buffer_barrier,
+    dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId};
 
@@ -68,7 +68,8 @@ impl MeshBuffers {
 
 /// The compute path's pipeline and buffers.
 pub struct GpuSilhouettes {
-    pipeline: Pipeline,
+    /// The silhouette pipeline, by whether the smoothie size is physical.
+    pipelines: Variants<bool>,
     meshes: Vec<(MeshId, MeshBuffers)>,
     params: Option<PerFrame>,
     vertices: Option<PerFrame>,
@@ -76,44 +77,20 @@ pub struct GpuSilhouettes {
     stamp: u32,
 }
 
-/// Grows `buffer` to hold `bytes` per frame (waiting for the GPU first: frames in flight may
-/// still read the old one).
-fn ensure_capacity(
-    ctx: &Context,
-    buffer: &mut Option<PerFrame>,
-    name: &str,
-    bytes: u64,
-    usage: vk::BufferUsageFlags,
-) -> Result<()> {
-    if buffer.as_ref().is_none_or(|b| b.capacity() < bytes) {
-        ctx.wait_idle()?;
-        buffer.take().into_iter().for_each(|b| b.destroy(ctx));
-        *buffer = Some(PerFrame::new(ctx, name, bytes.next_power_of_two(), FRAMES_IN_FLIGHT, usage)?);
-    }
-    Ok(())
-}
-
 impl GpuSilhouettes {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let s = Binding::Storage;
-        let pipeline = Pipeline::compute(
-            ctx,
-            "silhouettes",
-            shaders::SMOOTHIE_SILHOUETTES_COMP,
-            &[Binding::Uniform, s, s, s, s, s, s],
-        )?;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER
             | vk::BufferUsageFlags::INDIRECT_BUFFER
             | vk::BufferUsageFlags::TRANSFER_DST;
-        match PerFrame::new(ctx, "smoothie draw", 16, FRAMES_IN_FLIGHT, usage) {
-            Ok(args) => {
-                Ok(GpuSilhouettes { pipeline, meshes: Vec::new(), params: None, vertices: None, args, stamp: 0 })
-            }
-            Err(e) => {
-                pipeline.destroy(ctx);
-                Err(e)
-            }
-        }
+        let args = PerFrame::new(ctx, "smoothie draw", 16, FRAMES_IN_FLIGHT, usage)?;
+        Ok(GpuSilhouettes {
+            pipelines: Variants::default(),
+            meshes: Vec::new(),
+            params: None,
+            vertices: None,
+            args,
+            stamp: 0,
+        })
     }
 
     /// Records the silhouette dispatches of every caster seen through `view`; returns the
@@ -135,7 +112,7 @@ impl GpuSilhouettes {
         let capacity: u64 =
             casters.iter().map(|o| 6 * (o.mesh.adjacency.edges.len() + o.mesh.positions.len()) as u64).sum();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        ensure_capacity(
+        PerFrame::ensure(
             ctx,
             &mut self.vertices,
             "smoothies",
@@ -143,7 +120,7 @@ impl GpuSilhouettes {
             storage | vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
-        ensure_capacity(
+        PerFrame::ensure(
             ctx,
             &mut self.params,
             "silhouette params",
@@ -152,15 +129,23 @@ impl GpuSilhouettes {
         )?;
 
         let (scale, physical) = match size {
-            SmoothieSize::Physical { light_radius, scale } => (light_radius * scale, 1.0),
-            SmoothieSize::Fixed(t) => (t, 0.0),
+            SmoothieSize::Physical { light_radius, scale } => (light_radius * scale, true),
+            SmoothieSize::Fixed(t) => (t, false),
         };
+        let pipeline = self.pipelines.get(physical, |&physical| {
+            Pipeline::compute(
+                ctx,
+                "silhouettes",
+                &shaders::SMOOTHIE_SILHOUETTES_COMP,
+                &[("PHYSICAL_SIZE", physical as u32)],
+            )
+        })?;
         let mut params = Vec::with_capacity(casters.len());
         for o in &casters {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             params.push(SilhouetteParams {
                 model_view: *view * o.transform.matrix(),
-                size: Vec4::new(scale, physical, far, 0.0),
+                size: Vec4::new(scale, 0.0, far, 0.0),
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, 0],
                 pad: [Vec4::ZERO; 10],
             });
@@ -187,7 +172,7 @@ impl GpuSilhouettes {
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
                 range: PARAMS_BYTES,
             };
-            self.pipeline.bind(
+            pipeline.bind(
                 ctx,
                 cmd,
                 &[
@@ -199,7 +184,7 @@ impl GpuSilhouettes {
                     Descriptor::Buffer(args),
                     Descriptor::Buffer(vertices),
                 ],
-            );
+            )?;
             dispatch(ctx, cmd, mesh.edge_count.div_ceil(GROUP));
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
@@ -208,7 +193,7 @@ impl GpuSilhouettes {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        self.pipeline.destroy(ctx);
+        self.pipelines.destroy(ctx);
         self.meshes.into_iter().for_each(|(_, m)| m.destroy(ctx));
         self.params.into_iter().chain(self.vertices).for_each(|b| b.destroy(ctx));
         self.args.destroy(ctx);

@@ -12,7 +12,7 @@ use super::knobs::{Knob, Params};
 use super::registry::{Kind, Runs, SweepKnobs, TechniqueInfo};
 use crate::error::Result;
 use crate::frame::{FrameInputs, RAW_VISIBILITY_FORMAT, Surfaces, quantize};
-use crate::gpu::{Context, FRAMES_IN_FLIGHT, PerFrame, Target, copy_to_target};
+use crate::gpu::{Context, PerFrame, Target, copy_to_target};
 use crate::reference::TraceScene;
 
 pub const RAYTRACE: TechniqueInfo = TechniqueInfo {
@@ -98,14 +98,8 @@ impl Technique for Traced {
             texels = image.visibility.iter().map(|&v| quantize(v)).collect();
             bytemuck::cast_slice(&texels)
         };
-        if self.staging.as_ref().is_none_or(|s| s.capacity() < bytes.len() as u64) {
-            // Grows only; the old buffer may still be read by the frame in flight.
-            ctx.wait_idle()?;
-            self.staging.take().into_iter().for_each(|s| s.destroy(ctx));
-            let usage = vk::BufferUsageFlags::TRANSFER_SRC;
-            self.staging = Some(PerFrame::new(ctx, "traced visibility", bytes.len() as u64, FRAMES_IN_FLIGHT, usage)?);
-        }
-        let staging = self.staging.as_mut().expect("ensured");
+        let usage = vk::BufferUsageFlags::TRANSFER_SRC;
+        let staging = PerFrame::ensure(ctx, &mut self.staging, "traced visibility", bytes.len() as u64, usage)?;
         staging.write(frame.slot, bytes);
         frame.timer.begin(ctx, frame.cmd, "upload");
         copy_to_target(ctx, frame.cmd, staging.range(frame.slot), visibility);

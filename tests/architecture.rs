@@ -1,0 +1,96 @@
+//! DESIGN.md §2: rooms whose doors open one way. Each room of `src/` may import only the rooms
+//! below it; this test reads the sources and fails on a forbidden import (a `use
+//! crate::technique` inside `scene/`), and on Vulkan types where no Vulkan may be.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Each room and the rooms it may import (`error` is the crate's shared error type, below all).
+const ROOMS: &[(&str, &[&str])] = &[
+    ("error", &[]),
+    ("geometry", &["error"]),
+    ("gpu", &["error"]),
+    ("scene", &["error", "geometry"]),
+    ("frame", &["error", "geometry", "gpu", "scene"]),
+    ("technique", &["error", "geometry", "gpu", "scene", "frame", "reference"]),
+    ("reference", &["error", "geometry", "scene", "frame"]),
+    ("renderer", &["error", "geometry", "gpu", "scene", "frame", "technique"]),
+    ("measure", &["error", "geometry", "gpu", "scene", "frame", "technique", "renderer", "reference"]),
+];
+
+/// The crate-level paths each file of `dir` imports, keyed by file.
+fn imports(dir: &Path, out: &mut BTreeMap<String, Vec<(usize, String)>>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            imports(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let found = text
+                .lines()
+                .enumerate()
+                .flat_map(|(i, line)| {
+                    line.match_indices("crate::").map(move |(at, _)| {
+                        let room: String =
+                            line[at + 7..].chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+                        (i + 1, room)
+                    })
+                })
+                .collect();
+            out.insert(path.display().to_string(), found);
+        }
+    }
+}
+
+/// The room a file of `src/` belongs to: its folder, or its name for a file at the top.
+fn room_of(file: &str) -> String {
+    let rel = file.split("src/").nth(1).unwrap();
+    rel.split('/').next().unwrap().trim_end_matches(".rs").to_string()
+}
+
+#[test]
+fn every_room_imports_only_rooms_below_it() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = BTreeMap::new();
+    imports(&src, &mut files);
+    let mut forbidden = Vec::new();
+    for (file, found) in &files {
+        let room = room_of(file);
+        let Some((_, allowed)) = ROOMS.iter().find(|(r, _)| *r == room) else { continue };
+        for (line, target) in found {
+            if *target != room && !allowed.contains(&target.as_str()) {
+                forbidden.push(format!("{file}:{line}: `{room}` imports `{target}`"));
+            }
+        }
+    }
+    assert!(forbidden.is_empty(), "imports against DESIGN.md §2:\n{}", forbidden.join("\n"));
+}
+
+#[test]
+fn geometry_and_scene_know_no_vulkan() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    for room in ["geometry", "scene"] {
+        let mut files = BTreeMap::new();
+        imports(&src.join(room), &mut files);
+        for file in files.keys() {
+            let text = std::fs::read_to_string(file).unwrap();
+            for (i, line) in text.lines().enumerate() {
+                assert!(!line.contains("vk::") && !line.contains("ash::"), "{file}:{}: Vulkan in `{room}`", i + 1);
+            }
+        }
+    }
+}
+
+/// The rule has teeth: the scanner sees an import that breaks it.
+#[test]
+fn the_scanner_finds_a_forbidden_import() {
+    let dir = std::env::temp_dir().join(format!("softshadow-rooms-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("src/scene")).unwrap();
+    std::fs::write(dir.join("src/scene/bad.rs"), "use crate::technique::knobs;\n").unwrap();
+    let mut files = BTreeMap::new();
+    imports(&dir.join("src"), &mut files);
+    let (file, found) = files.iter().next().unwrap();
+    assert_eq!(room_of(file), "scene");
+    assert_eq!(found, &vec![(1, "technique".to_string())]);
+    std::fs::remove_dir_all(dir).unwrap();
+}
