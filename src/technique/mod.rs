@@ -17,7 +17,21 @@ use crate::error::Result;
 use crate::frame::{FrameInputs, Surfaces};
 use crate::gpu::{Context, Target};
 pub use knobs::{Knob, Params};
-pub use registry::{Kind, Runs, TECHNIQUES, TechniqueInfo, find};
+pub use registry::{Kind, Runs, TechniqueInfo, find};
+
+/// Every technique this build knows, in the order tools list them: the registry. Adding a
+/// technique is one file beside this one that defines its [`TechniqueInfo`], its `mod` line
+/// above, and its line here.
+pub const TECHNIQUES: &[&TechniqueInfo] = &[
+    &shadow_map::INFO,
+    &shadow_map::PCF,
+    &shadow_map::PCSS,
+    &plateau::INFO,
+    &smoothie::INFO,
+    &reference::INFO,
+    &traced::RAYTRACE,
+    &traced::PARKER,
+];
 
 /// A shadowing technique: records its passes and leaves V written (the composite transitions
 /// it from whichever access wrote it).

@@ -1,29 +1,14 @@
-//! The registry: the only list of techniques. Each entry carries what every tool needs to know
-//! about a technique (its name, summary, knobs, kind, constructor, and the settings the
-//! measurements sweep), so `create`, `softshadow techniques`, bench, showcase, the stability
-//! sweep and the tests all iterate [`TECHNIQUES`] and none of them names a technique.
-//!
-//! Adding a technique is one file in `technique/` that defines its [`TechniqueInfo`], and one
-//! line below.
+//! The registry's entries: each carries what every tool needs to know about a technique (its
+//! name, summary, knobs, kind, constructor, and the settings the measurements sweep), so
+//! `create`, `softshadow techniques`, bench, showcase, the stability sweep and the tests all
+//! iterate [`TECHNIQUES`](super::TECHNIQUES), the only list, and none of them names a technique.
 
 use ash::vk;
 
 use super::knobs::Knob;
-use super::{Technique, plateau, reference, shadow_map, smoothie, traced};
+use super::{TECHNIQUES, Technique};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-
-/// Every technique this build knows, in the order tools list them.
-pub const TECHNIQUES: &[&TechniqueInfo] = &[
-    &shadow_map::INFO,
-    &shadow_map::PCF,
-    &shadow_map::PCSS,
-    &plateau::INFO,
-    &smoothie::INFO,
-    &reference::INFO,
-    &traced::RAYTRACE,
-    &traced::PARKER,
-];
 
 /// What a technique is, for the tools that choose how to run and judge it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
