@@ -107,17 +107,51 @@ fn low_lights_stretch_the_shadow_without_breaking() {
 
 #[test]
 fn a_caster_reaching_above_the_light_casts_no_anti_shadow() {
-    // A tall post whose top is above the light: the part above casts nothing (clipped at w = 0),
-    // so the ground between the post and the light stays lit.
+    // A tall post (0.3 m square, 6 m) whose top is 4 m above the light (2 m up at x = 2): the part
+    // above casts nothing (clipped at w = 0), and the shadow of the part below runs to the
+    // horizon along −x, inside the wedge from the light's foot through the post's corners
+    // (0.15, ±0.15): |z| ≤ 0.15·(2 − x)/1.85. Seen from above, 8 px per metre: column 8·(x + 4),
+    // row 8·(z + 4). Were the part above drawn, its anti-shadow would land on the light's side
+    // (x ≥ 2 + 1.85·2/4 ≈ 2.9 for the post's top), or the clip would smear it across the light.
     let post = "[[object]]\nshape = \"box\"\nsize = [0.3, 6.0, 0.3]\nposition = [0.0, 3.0, 0.0]\n";
     let s = top_down(0.0, 4.0, [2.0, 2.0, 0.0], 0.1, post);
     let mut e = engine();
     let c = render_with(&mut e, &s, "plateau", &[], 64);
-    // Between the post (x = 0) and the light's foot (x = 2): lit. Behind the post: shadow.
-    for x in [40, 44, 48] {
-        assert!(c.visibility_at(x, 32) > 0.99, "anti-shadow at column {x}: {}", c.visibility_at(x, 32));
+    let world = |i: u32| (i as f32 + 0.5) / 8.0 - 4.0;
+    let wedge = |x: f32| 0.15 * (2.0 - x) / 1.85;
+    // A pixel of margin: the hard edge's rasterisation (texture texels, the view's pixels).
+    let margin = 1.0 / 8.0;
+    let (mut dark, mut lit, mut stopped, mut stray) = (0, 0, Vec::new(), Vec::new());
+    for col in 0..64 {
+        let x = world(col);
+        for row in 0..64 {
+            let (z, v) = (world(row), c.visibility_at(col, row));
+            let at = format!("({x:.2}, {z:.2}) V = {v:.2}");
+            if x < -0.15 - margin && z.abs() < wedge(x) - margin {
+                // Behind the post, inside the wedge: dark all the way to the image's edge.
+                dark += 1;
+                if v >= 0.05 {
+                    stopped.push(at);
+                }
+            } else if x > 0.15 + margin || z.abs() > wedge(x) + margin {
+                // The light's side of the post and beside the wedge: lit, no anti-shadow.
+                lit += 1;
+                if v <= 0.99 {
+                    stray.push(at);
+                }
+            }
+        }
     }
-    assert!((0..28).any(|x| c.visibility_at(x, 32) < 0.05), "the post's lower part still casts");
+    assert!(dark >= 60 && lit >= 3000, "the checks cover the shadow and its surroundings: {dark} dark, {lit} lit px");
+    let first = |p: &Vec<String>| p[..p.len().min(4)].join(", ");
+    assert!(
+        stopped.is_empty() && stray.is_empty(),
+        "{} of {dark} px in the wedge lit, first [{}]; {} of {lit} px outside it shadowed, first [{}]",
+        stopped.len(),
+        first(&stopped),
+        stray.len(),
+        first(&stray)
+    );
     finish(e);
 }
 

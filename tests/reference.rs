@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 
 use common::{engine, finish, render_with, scene, suite_scene};
 use glam::Vec3;
+use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::reference::{Surface, TraceScene};
 use softshadow::scene::Scene;
@@ -188,6 +189,52 @@ fn a_point_light_makes_every_ground_truth_a_hard_shadow() {
     let traced = render_with(&mut e, &s, "raytrace", &[], 64);
     assert!(traced.visibility.iter().all(|&v| v == 0 || v == 65535), "a point light leaves no penumbra");
     let m = Metrics::between(&reference, &traced).unwrap();
-    assert!(m.rmse < 0.1 && m.p99_abs < 1.0, "{m:?}");
+    assert!(m.rmse < 0.1, "{m:?}");
+    // Both are hard shadows of the same caster from the same point, so they can disagree only
+    // where the map's texel grid moves the edge: by the bilinear's texel plus the depth bias,
+    // about two texels. The map is fitted around the plate (~2.8 m over 512 texels, ~0.7 cm on
+    // the ground) and a pixel of the 64² view is ~10 cm, so the edge moves by ~0.15 px. Hence
+    // every pixel the reference gets wrong lies on the true shadow's boundary (a traced
+    // neighbour has the other value), and is wrong only when the true edge passes that close to
+    // its centre: ~0.15 of the pixels the edge crosses, which are about half the boundary (it
+    // holds both sides), so at most an eighth of the boundary.
+    let (boundary, wrong, stray) = edge_disagreement(&reference, &traced);
+    assert!(boundary > 20, "the plate's shadow must have an edge in view ({boundary} px)");
+    let first = &stray[..stray.len().min(8)];
+    assert!(stray.is_empty(), "{} px wrong away from the true shadow's edge, first {first:?} ({m:?})", stray.len());
+    assert!(
+        8 * wrong <= boundary,
+        "{wrong} of {boundary} edge pixels wrong: the edge moved by more than a texel and the bias ({m:?})"
+    );
     finish(e);
+}
+
+/// Against a binary `truth`: its boundary pixels (receivers with an 8-neighbour of the other
+/// V), how many receivers `v` gets wrong at all, and those wrong ones off the boundary.
+fn edge_disagreement(v: &Capture, truth: &Capture) -> (usize, usize, Vec<(u32, u32)>) {
+    let (w, h) = (truth.width as i64, truth.height as i64);
+    let at = |x: i64, y: i64| (y * w + x) as usize;
+    let (mut boundary, mut wrong, mut stray) = (0, 0, Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let i = at(x, y);
+            if !(truth.surfaces.receives[i] && v.surfaces.receives[i]) {
+                continue;
+            }
+            let on_edge = (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy))).any(|(nx, ny)| {
+                (0..w).contains(&nx)
+                    && (0..h).contains(&ny)
+                    && truth.surfaces.receives[at(nx, ny)]
+                    && truth.visibility[at(nx, ny)] != truth.visibility[i]
+            });
+            boundary += usize::from(on_edge);
+            if v.visibility[i] != truth.visibility[i] {
+                wrong += 1;
+                if !on_edge {
+                    stray.push((x as u32, y as u32));
+                }
+            }
+        }
+    }
+    (boundary, wrong, stray)
 }

@@ -319,6 +319,15 @@ mod tests {
         Cone { centre: Vec2::new(x, y), axes: Mat2::from_diagonal(Vec2::splat(r)) }
     }
 
+    /// Two cone radii in `min..2`: equal in a third of the cases (a plate parallel to the plane,
+    /// every sheet flat), which two independent draws would essentially never give.
+    fn radii(min: f32) -> impl Strategy<Value = (f32, f32)> {
+        prop_oneof![
+            1 => (min..2.0f32).prop_map(|r| (r, r)),
+            2 => (min..2.0f32, min..2.0f32),
+        ]
+    }
+
     /// Distance from `p` to the line through `a` and `b`.
     fn line_distance(p: Vec2, a: Vec2, b: Vec2) -> f32 {
         ((b - a).perp_dot(p - a) / (b - a).length()).abs()
@@ -344,7 +353,7 @@ mod tests {
 
         #[test]
         fn outer_tangents_touch_both_circles(
-            r0 in 0.0f32..2.0, r1 in 0.0f32..2.0, d in 0.01f32..6.0, angle in 0.0f32..std::f32::consts::TAU,
+            (r0, r1) in radii(0.0), d in 0.01f32..6.0, angle in 0.0f32..std::f32::consts::TAU,
         ) {
             let a = circle(0.3, -0.2, r0);
             let b = circle(0.3 + d * angle.cos(), -0.2 + d * angle.sin(), r1);
@@ -364,18 +373,25 @@ mod tests {
                 }
                 // On the outward side.
                 prop_assert!((ta - a.centre).dot(outward) >= -1e-4);
+                if r0 == r1 {
+                    // Equal circles: the tangent runs parallel to the centre line, one radius
+                    // out, touching each circle straight across from its centre.
+                    let normal = (b.centre - a.centre).perp().normalize() * (b.centre - a.centre).perp().dot(outward).signum();
+                    prop_assert!((ta - (a.centre + r0 * normal)).length() < 1e-4 * (1.0 + r0), "{ta} vs {}", a.centre + r0 * normal);
+                    prop_assert!((tb - (b.centre + r1 * normal)).length() < 1e-4 * (1.0 + r1), "{tb} vs {}", b.centre + r1 * normal);
+                }
             }
         }
 
         #[test]
-        fn sheets_tessellate_by_twist_with_t_in_range(r0 in 0.01f32..2.0, r1 in 0.01f32..2.0) {
+        fn sheets_tessellate_by_twist_with_t_in_range((r0, r1) in radii(0.01)) {
             let mut g = PlateauGeometry::default();
             let (a, b) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1));
             let (ta, tb) = outer_tangent(&a, &b, Vec2::Y).unwrap();
             g.push_sheet(a.centre, b.centre, ta, tb);
             prop_assert!(g.sheets.iter().all(|v| v.u.is_finite() && v.v.is_finite() && (0.0..=1.0).contains(&v.t)));
             let quads = g.sheets.len() / 6;
-            if (r0 - r1).abs() < 1e-6 {
+            if r0 == r1 {
                 prop_assert_eq!(quads, 1, "equal radii: one flat quad");
             }
             // Twice the radius difference never needs fewer cells.
@@ -465,6 +481,48 @@ mod tests {
         // Haines' constant factor: radius = factor × height.
         let haines = vertex_cone(&plane, Vec3::Y * 5.0, 0.5, PenumbraSize::Haines { factor: 0.1 }, p).unwrap();
         assert!((haines.axes.col(0).length() - 0.1).abs() < 1e-6);
+    }
+
+    #[test]
+    fn equal_radii_make_a_tangent_parallel_to_the_centre_line_and_one_flat_quad() {
+        for r in [0.0, 0.05, 0.5, 1.0, 2.0] {
+            for (i, angle) in [0.0f32, 0.7, 2.0, 3.9, 5.5].into_iter().enumerate() {
+                let d = 0.5 + i as f32;
+                let a = circle(-0.4, 1.3, r);
+                let along = Vec2::from_angle(angle);
+                let b = circle(-0.4 + d * along.x, 1.3 + d * along.y, r);
+                for outward in [along.perp(), -along.perp()] {
+                    let (ta, tb) = outer_tangent(&a, &b, outward).expect("equal circles apart have outer tangents");
+                    // Straight across from each centre, one radius out on the outward side: the
+                    // tangent is the centre line moved sideways by r.
+                    let tol = 1e-4 * (1.0 + r);
+                    assert!(
+                        (ta - (a.centre + r * outward)).length() < tol,
+                        "r {r}, {angle} rad: {ta} vs {}",
+                        a.centre + r * outward
+                    );
+                    assert!(
+                        (tb - (b.centre + r * outward)).length() < tol,
+                        "r {r}, {angle} rad: {tb} vs {}",
+                        b.centre + r * outward
+                    );
+                    assert!((tb - ta).perp_dot(along).abs() < tol, "not parallel to the centre line");
+                    let mut g = PlateauGeometry::default();
+                    g.push_sheet(a.centre, b.centre, ta, tb);
+                    if r == 0.0 {
+                        assert!(g.sheets.is_empty(), "point bases: a hard edge, no sheet");
+                        continue;
+                    }
+                    // No twist: one flat quad, t = 0 along the hard edge and 1 along the tangent.
+                    assert_eq!(g.sheets.len(), 6, "r {r}: one quad, two triangles");
+                    for v in &g.sheets {
+                        let p = Vec2::new(v.u, v.v);
+                        let off = (p - a.centre).dot(outward);
+                        assert!((off - v.t * r).abs() < tol, "r {r}: t {} at offset {off}", v.t);
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -161,13 +161,61 @@ impl TraceScene {
 mod tests {
     use super::*;
 
+    /// §3's Bernstein interpolant in closed form, in f64: s = 3τ² − 2τ³.
+    fn bernstein(t: f64) -> f64 {
+        3.0 * t * t - 2.0 * t * t * t
+    }
+
+    /// §3's straight-edge sinusoid, s = (1 + sin(πτ − π/2)) / 2, which the cubic stands in for.
+    fn sinusoid(t: f64) -> f64 {
+        (1.0 + (std::f64::consts::PI * t - std::f64::consts::FRAC_PI_2).sin()) / 2.0
+    }
+
     #[test]
-    fn the_profile_meets_the_sinusoid_at_its_ends() {
-        let sinusoid = |t: f32| (1.0 + (std::f32::consts::PI * t - std::f32::consts::FRAC_PI_2).sin()) / 2.0;
-        for t in [0.0, 1.0] {
-            assert!((profile(t) - sinusoid(t)).abs() < 1e-6);
+    fn the_profile_is_the_bernstein_cubic_at_every_tau() {
+        // Exact rationals inside the shell: 3/16 − 2/64 = 5/32 and 27/16 − 54/64 = 27/32 (the
+        // sinusoid gives 0.1464 and 0.8536 there, the identity 1/4 and 3/4).
+        assert!((profile(0.25) - 5.0 / 32.0).abs() < 1e-6, "s(1/4) = {}", profile(0.25));
+        assert!((profile(0.75) - 27.0 / 32.0).abs() < 1e-6, "s(3/4) = {}", profile(0.75));
+        for i in 0..=512 {
+            let t = i as f64 / 512.0;
+            let s = profile(t as f32) as f64;
+            assert!((s - bernstein(t)).abs() < 1e-6, "s({t}) = {s}, 3τ² − 2τ³ = {}", bernstein(t));
         }
-        assert!((profile(0.5) - 0.5).abs() < 1e-6);
+        // Outside the shell: fully dark inside the inner object, fully lit past the outer one.
+        assert_eq!((profile(-0.5), profile(1.5)), (0.0, 1.0));
+    }
+
+    #[test]
+    fn the_profile_shares_the_sinusoids_ends_but_is_a_polynomial() {
+        // §3: the same values and derivatives as the sinusoid at τ = 0 and τ = 1 (both slopes
+        // 0, so the shadow has no crease at the penumbra's borders)...
+        let h = 1e-3f32;
+        for (t, s) in [(0.0, 0.0), (1.0, 1.0)] {
+            assert!((profile(t) as f64 - sinusoid(t as f64)).abs() < 1e-6 && profile(t) == s);
+        }
+        let (slope0, slope1) = (profile(h) / h, (1.0 - profile(1.0 - h)) / h);
+        assert!(slope0 < 1e-2 && slope1 < 1e-2, "end slopes {slope0} {slope1}, should be 0");
+        // ... and the cubic's slope at ½ is 3/2 where the sinusoid's is π/2 and the identity's 1.
+        let mid = (profile(0.5 + h) - profile(0.5 - h)) as f64 / (2.0 * h as f64);
+        assert!((mid - 1.5).abs() < 1e-2, "slope at 1/2: {mid}");
+        // Between the ends it is not the sinusoid: they part by about 0.01 (at τ ≈ 0.2, 0.8).
+        let apart = (0..=100).map(|i| i as f64 / 100.0).map(|t| (profile(t as f32) as f64 - sinusoid(t)).abs());
+        let apart = apart.fold(0.0, f64::max);
+        assert!(apart > 5e-3 && apart < 2e-2, "max |cubic − sinusoid| = {apart}");
+    }
+
+    #[test]
+    fn the_profile_rises_monotonically_and_symmetrically_about_a_half() {
+        let mut last = profile(0.0);
+        for i in 1..=1000 {
+            let t = i as f32 / 1000.0;
+            let s = profile(t);
+            assert!(s >= last, "falls at τ = {t}: {s} < {last}");
+            // Point-symmetric about (½, ½): s(τ) + s(1 − τ) = 1.
+            assert!((s + profile(1.0 - t) - 1.0).abs() < 1e-6, "not symmetric at τ = {t}");
+            last = s;
+        }
     }
 
     #[test]
@@ -188,6 +236,9 @@ mod tests {
         assert_eq!(ray.sphere(Vec3::new(0.5, 5.0, 0.0), 1.0), 0.0);
         // b = D·t0/A = 0.5: halfway through the outer shell.
         assert!((ray.sphere(Vec3::new(1.25, 5.0, 0.0), 1.0) - 0.5).abs() < 1e-5);
+        // A quarter and three quarters through the shell: the cubic's 5/32 and 27/32.
+        assert!((ray.sphere(Vec3::new(1.125, 5.0, 0.0), 1.0) - 5.0 / 32.0).abs() < 1e-5);
+        assert!((ray.sphere(Vec3::new(1.375, 5.0, 0.0), 1.0) - 27.0 / 32.0).abs() < 1e-5);
         assert_eq!(ray.sphere(Vec3::new(1.6, 5.0, 0.0), 1.0), 1.0);
         // Behind the point: no shadow.
         assert_eq!(ray.sphere(Vec3::new(0.0, -5.0, 0.0), 1.0), 1.0);
