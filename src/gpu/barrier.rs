@@ -40,6 +40,16 @@ impl Access {
         ),
         layout: vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
     };
+    /// Tested and written as a depth-stencil attachment (depth and stencil aspects).
+    pub const DEPTH_STENCIL_WRITE: Access =
+        Access { layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, ..Access::DEPTH_WRITE };
+    /// Tested, not written, as a depth-stencil attachment (a stencil test against a finished
+    /// count, depth testing against a finished prepass).
+    pub const DEPTH_STENCIL_READ: Access = Access {
+        stage: Access::DEPTH_WRITE.stage,
+        access: vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+        layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+    };
     /// Sampled by fragment shaders (color).
     pub const FRAGMENT_READ: Access = Access {
         stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
@@ -151,4 +161,20 @@ pub fn buffer_barrier(ctx: &Context, cmd: vk::CommandBuffer, before: BufferAcces
         .dst_stage_mask(after.stage)
         .dst_access_mask(after.access)];
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A write must be made available before the next access: every writing access says so.
+    #[test]
+    fn writes_are_known_as_writes() {
+        for write in [Access::COLOR_WRITE, Access::DEPTH_WRITE, Access::DEPTH_STENCIL_WRITE, Access::COPY_WRITE] {
+            assert!(is_write(write.access), "{write:?}");
+        }
+        for read in [Access::NONE, Access::DEPTH_STENCIL_READ, Access::FRAGMENT_READ, Access::COPY_READ] {
+            assert!(!is_write(read.access), "{read:?}");
+        }
+    }
 }

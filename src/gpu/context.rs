@@ -1,8 +1,8 @@
 //! Instance, device, queue and allocator: Vulkan 1.3 with dynamic rendering and
-//! synchronization2, push descriptors for every pass, validation on request.
+//! synchronization2, push descriptors for every pass, validation on request; on a device of our
+//! own, or on the embedder's.
 
 use std::ffi::{CStr, c_char};
-use std::mem::ManuallyDrop;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -10,9 +10,13 @@ use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::debug::{VALIDATION_LAYER, ValidationLog, messenger_info};
+use super::device::{
+    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_device_extensions,
+    required_vulkan13_features,
+};
 use crate::error::{Error, Result, VkContext};
 
-const INSTALL_HINT: &str = "install a Vulkan driver, e.g. `apt-get install libvulkan1 mesa-vulkan-drivers`";
+pub(super) const INSTALL_HINT: &str = "install a Vulkan driver, e.g. `apt-get install libvulkan1 mesa-vulkan-drivers`";
 
 /// How to create the [`Context`].
 #[derive(Clone, Debug, Default)]
@@ -46,31 +50,81 @@ pub struct DeviceInfo {
     pub timestamp_valid_bits: u32,
 }
 
-/// The Vulkan plumbing every pass uses. Owns the device; destroyed last.
+/// Whether the context created the instance and device, and so destroys them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ownership {
+    /// Made by [`Context::new`] (or [`Context::headless`]): `destroy` destroys the device, the
+    /// debug messenger and the instance.
+    Owned,
+    /// The embedder's ([`Context::from_handles`]): never destroyed here.
+    Borrowed,
+}
+
+/// The handles of a device an embedder created, for [`Context::from_handles`].
+pub struct EmbedderHandles {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    /// Created with [`required_device_extensions`](super::required_device_extensions) and
+    /// [`required_vulkan13_features`](super::required_vulkan13_features).
+    pub device: ash::Device,
+    pub queue_family: u32,
+    /// A queue of `queue_family` that the device was created with.
+    pub queue_index: u32,
+    /// The Vulkan 1.3 features passed to `vkCreateDevice` (Vulkan cannot be asked afterwards).
+    pub enabled_features: vk::PhysicalDeviceVulkan13Features<'static>,
+}
+
+/// The Vulkan plumbing every pass uses, on a device of its own or the embedder's; destroyed last.
 pub struct Context {
     _entry: ash::Entry,
     pub(crate) instance: ash::Instance,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
+    pub(crate) physical: vk::PhysicalDevice,
     pub(crate) device: ash::Device,
     pub(crate) push_descriptor: ash::khr::push_descriptor::Device,
     pub(crate) queue: vk::Queue,
     pub(crate) queue_family: u32,
-    allocator: ManuallyDrop<Mutex<Allocator>>,
+    ownership: Ownership,
+    // `None` only after `destroy`.
+    allocator: Option<Mutex<Allocator>>,
     live_allocations: AtomicUsize,
     /// Clamp-to-edge nearest sampler, immutable in every layout that samples a target.
     pub(crate) nearest_sampler: vk::Sampler,
     pub(crate) limits: vk::PhysicalDeviceLimits,
+    depth_stencil_format: vk::Format,
     pub info: DeviceInfo,
     // Boxed: the messenger holds a pointer to it. Dropped after the instance.
     log: Box<ValidationLog>,
     destroyed: bool,
 }
 
+/// What a constructor hands to `assemble`: the handles, and what was learned checking the device.
+struct Parts {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    debug_utils: bool,
+    physical: vk::PhysicalDevice,
+    device: ash::Device,
+    queue_family: u32,
+    queue_index: u32,
+    depth_stencil_format: vk::Format,
+    ownership: Ownership,
+    log: Box<ValidationLog>,
+}
+
 impl Context {
-    /// A context without a window: tests, offscreen rendering, benchmarks. A windowed
-    /// constructor will share everything but the surface check.
+    /// A context without a window: tests, offscreen rendering, benchmarks.
     pub fn headless(options: &ContextOptions) -> Result<Self> {
+        Context::new(options, &DeviceFilter::HEADLESS)
+    }
+
+    /// Creates an instance and a device of its own. The one construction path: a windowed
+    /// context differs from [`Context::headless`] only in its `filter` (surface extensions, and
+    /// a queue family that can present).
+    pub fn new(options: &ContextOptions, filter: &DeviceFilter) -> Result<Self> {
         // SAFETY: loading the system Vulkan loader; it is kept alive in `_entry`.
         let entry = unsafe { ash::Entry::load() }
             .map_err(|e| Error::NoDevice(format!("no Vulkan loader ({e}): {INSTALL_HINT}")))?;
@@ -79,8 +133,11 @@ impl Context {
         let available_ext = unsafe { entry.enumerate_instance_extension_properties(None) }
             .vk("vkEnumerateInstanceExtensionProperties")?;
         let has_ext = |name: &CStr| available_ext.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
+        if let Some(missing) = filter.instance_extensions.iter().find(|name| !has_ext(name)) {
+            return Err(Error::NoDevice(format!("the Vulkan instance lacks {}", missing.to_string_lossy())));
+        }
         let debug_utils = has_ext(ash::ext::debug_utils::NAME);
-        let mut extensions: Vec<*const c_char> = Vec::new();
+        let mut extensions: Vec<*const c_char> = filter.instance_extensions.iter().map(|e| e.as_ptr()).collect();
         if debug_utils {
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
@@ -119,7 +176,7 @@ impl Context {
             vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDevice(format!("no Vulkan 1.3 driver: {INSTALL_HINT}")),
             result => Error::Vulkan { call: "vkCreateInstance", result },
         })?;
-        // From here on, failures must destroy what exists: build the rest in a guard.
+        // Until the context exists, failures must destroy what does: build the rest in a guard.
         let mut guard = InstanceGuard { instance: Some(instance), messenger: None };
         let instance = guard.instance.as_ref().expect("just created");
         if options.validation {
@@ -129,73 +186,77 @@ impl Context {
             guard.messenger = Some((loader, messenger));
         }
 
-        let (physical, props) = pick_device(instance, options.device.as_deref())?;
-        let queue_family = unsafe { instance.get_physical_device_queue_family_properties(physical) }
-            .iter()
-            .position(|q| {
-                q.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) && q.timestamp_valid_bits > 0
-            })
-            .ok_or_else(|| {
-                Error::NoDevice(format!("{}: no graphics and compute queue with timestamps", name_of(&props)))
-            })? as u32;
-        let timestamp_valid_bits = unsafe { instance.get_physical_device_queue_family_properties(physical) }
-            [queue_family as usize]
-            .timestamp_valid_bits;
-
+        let picked = pick_device(instance, options.device.as_deref(), filter)?;
         let priorities = [1.0];
-        let queue_ci =
-            [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&priorities)];
-        let device_ext = [ash::khr::push_descriptor::NAME.as_ptr()];
-        // maintenance4 (required of every Vulkan 1.3 device) lets SPIR-V 1.6 compute shaders
-        // declare their workgroup size with LocalSizeId, as shaderc emits it.
-        let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
-            .dynamic_rendering(true)
-            .synchronization2(true)
-            .maintenance4(true);
+        let queue_ci = [vk::DeviceQueueCreateInfo::default()
+            .queue_family_index(picked.queue_family)
+            .queue_priorities(&priorities)];
+        let device_ext: Vec<_> =
+            required_device_extensions().iter().chain(filter.device_extensions).map(|e| e.as_ptr()).collect();
+        let mut v13 = required_vulkan13_features();
         let device_ci = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_ci)
             .enabled_extension_names(&device_ext)
             .push_next(&mut v13);
-        let device = unsafe { instance.create_device(physical, &device_ci, None) }.vk("vkCreateDevice")?;
-        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let device = unsafe { instance.create_device(picked.physical, &device_ci, None) }.vk("vkCreateDevice")?;
+        Context::assemble(Parts {
+            entry,
+            instance: guard.instance.take().expect("guarded instance"),
+            messenger: guard.messenger.take(),
+            debug_utils,
+            physical: picked.physical,
+            device,
+            queue_family: picked.queue_family,
+            queue_index: 0,
+            depth_stencil_format: picked.depth_stencil_format,
+            ownership: Ownership::Owned,
+            log,
+        })
+    }
 
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: instance.clone(),
-            device: device.clone(),
-            physical_device: physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        });
-        let allocator = match allocator {
-            Ok(a) => a,
-            Err(e) => {
-                unsafe { device.destroy_device(None) };
-                return Err(e.into());
-            }
-        };
-        let sampler_ci = vk::SamplerCreateInfo::default()
-            .mag_filter(vk::Filter::NEAREST)
-            .min_filter(vk::Filter::NEAREST)
-            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
-            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-            .max_lod(0.0);
-        let nearest_sampler = match unsafe { device.create_sampler(&sampler_ci, None) } {
-            Ok(s) => s,
-            Err(result) => {
-                drop(allocator);
-                unsafe { device.destroy_device(None) };
-                return Err(Error::Vulkan { call: "vkCreateSampler", result });
-            }
-        };
+    /// A context on the embedder's instance and device (as Dear ImGui's Vulkan backend is built):
+    /// it creates and destroys only its own objects (allocator, sampler), never the instance or
+    /// the device. Its validation log stays empty: messages go to the embedder's messenger, if any.
+    ///
+    /// # Safety
+    /// The handles must be valid, belong together, and outlive the context; the embedder must not
+    /// use the queue from another thread while the context submits to it or waits on it.
+    pub unsafe fn from_handles(handles: EmbedderHandles) -> Result<Self> {
+        let EmbedderHandles { entry, instance, physical_device, device, queue_family, queue_index, enabled_features } =
+            handles;
+        let depth_stencil_format =
+            check_embedder_device(&instance, physical_device, &device, queue_family, &enabled_features)?;
+        // Object names need the embedder's instance to have enabled debug utils.
+        let debug_utils = unsafe {
+            (instance.fp_v1_0().get_device_proc_addr)(device.handle(), c"vkSetDebugUtilsObjectNameEXT".as_ptr())
+        }
+        .is_some();
+        Context::assemble(Parts {
+            entry,
+            instance,
+            messenger: None,
+            debug_utils,
+            physical: physical_device,
+            device,
+            queue_family,
+            queue_index,
+            depth_stencil_format,
+            ownership: Ownership::Borrowed,
+            log: Box::default(),
+        })
+    }
 
+    /// The part both constructors share, once a device exists: the context is built at once, so
+    /// that a failure past this point is cleaned up by its `Drop`, which respects `ownership`.
+    fn assemble(parts: Parts) -> Result<Self> {
+        let Parts { entry, instance, messenger, debug_utils, physical, device, .. } = parts;
+        let props = unsafe { instance.get_physical_device_properties(physical) };
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let limits = props.limits;
         let v = props.api_version;
         let info = DeviceInfo {
             name: name_of(&props),
-            driver: driver_of(instance, physical),
+            driver: driver_of(&instance, physical),
             device_type: format!("{:?}", props.device_type),
             vulkan_version: format!(
                 "{}.{}.{}",
@@ -206,34 +267,76 @@ impl Context {
             max_image_dimension_2d: limits.max_image_dimension2_d,
             max_push_constants_size: limits.max_push_constants_size,
             timestamp_period_ns: limits.timestamp_period,
-            timestamp_valid_bits,
+            timestamp_valid_bits: families[parts.queue_family as usize].timestamp_valid_bits,
         };
-        let instance = guard.instance.take().expect("guarded instance");
-        let messenger = guard.messenger.take();
-        let debug_utils = debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device));
-        let push_descriptor = ash::khr::push_descriptor::Device::new(&instance, &device);
-        let ctx = Context {
+        let mut ctx = Context {
+            queue: unsafe { device.get_device_queue(parts.queue_family, parts.queue_index) },
+            debug_utils: debug_utils.then(|| ash::ext::debug_utils::Device::new(&instance, &device)),
+            push_descriptor: ash::khr::push_descriptor::Device::new(&instance, &device),
             _entry: entry,
             instance,
             messenger,
-            debug_utils,
+            physical,
             device,
-            push_descriptor,
-            queue,
-            queue_family,
-            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            queue_family: parts.queue_family,
+            ownership: parts.ownership,
+            allocator: None,
             live_allocations: AtomicUsize::new(0),
-            nearest_sampler,
+            nearest_sampler: vk::Sampler::null(),
             limits,
+            depth_stencil_format: parts.depth_stencil_format,
             info,
-            log,
+            log: parts.log,
             destroyed: false,
         };
+        ctx.allocator = Some(Mutex::new(Allocator::new(&AllocatorCreateDesc {
+            instance: ctx.instance.clone(),
+            device: ctx.device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })?));
+        let sampler_ci = vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::NEAREST)
+            .min_filter(vk::Filter::NEAREST)
+            .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+            .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0);
+        ctx.nearest_sampler = unsafe { ctx.device.create_sampler(&sampler_ci, None) }.vk("vkCreateSampler")?;
         ctx.name(ctx.nearest_sampler, "nearest clamp sampler");
         Ok(ctx)
     }
 
-    /// Validation errors recorded so far (empty when validation is off).
+    /// Whether `destroy` destroys the instance and device.
+    pub fn ownership(&self) -> Ownership {
+        self.ownership
+    }
+
+    /// The instance (the embedder's, or our own).
+    pub fn instance(&self) -> &ash::Instance {
+        &self.instance
+    }
+
+    pub fn physical_device(&self) -> vk::PhysicalDevice {
+        self.physical
+    }
+
+    /// The device, for objects an embedder makes itself (images to wrap, semaphores).
+    pub fn device(&self) -> &ash::Device {
+        &self.device
+    }
+
+    /// The depth-stencil format of [`TargetDesc::depth_stencil`](super::TargetDesc::depth_stencil)
+    /// targets: D32_SFLOAT_S8_UINT, or D24_UNORM_S8_UINT where that is missing.
+    pub fn depth_stencil_format(&self) -> vk::Format {
+        self.depth_stencil_format
+    }
+
+    /// Validation errors recorded so far: empty when validation is off, and always for a context
+    /// [`from_handles`](Context::from_handles), whose messages go to the embedder's messenger.
     pub fn validation_errors(&self) -> Vec<String> {
         self.log.errors()
     }
@@ -243,11 +346,15 @@ impl Context {
         self.live_allocations.load(Ordering::Relaxed)
     }
 
+    fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
+        self.allocator.as_ref().expect("allocator used after destroy").lock().expect("allocator lock")
+    }
+
     pub(crate) fn allocate(
         &self,
         desc: &gpu_allocator::vulkan::AllocationCreateDesc<'_>,
     ) -> Result<gpu_allocator::vulkan::Allocation> {
-        let allocation = self.allocator.lock().expect("allocator lock").allocate(desc)?;
+        let allocation = self.allocator().allocate(desc)?;
         self.live_allocations.fetch_add(1, Ordering::Relaxed);
         Ok(allocation)
     }
@@ -255,7 +362,7 @@ impl Context {
     pub(crate) fn free(&self, allocation: gpu_allocator::vulkan::Allocation) {
         self.live_allocations.fetch_sub(1, Ordering::Relaxed);
         // Freeing only fails for a foreign allocation, which this crate never makes.
-        if let Err(e) = self.allocator.lock().expect("allocator lock").free(allocation) {
+        if let Err(e) = self.allocator().free(allocation) {
             eprintln!("softshadow: freeing GPU memory failed: {e}");
         }
     }
@@ -270,30 +377,34 @@ impl Context {
         }
     }
 
-    /// Waits for the queue to drain (before destroying or re-creating resources it may use).
+    /// Waits for our queue to drain (before destroying or re-creating resources it may use).
+    /// Only the queue: on an embedder's device, its other queues are none of our business.
     pub fn wait_idle(&self) -> Result<()> {
         if self.destroyed {
             return Ok(()); // nothing can be in flight on a destroyed device
         }
-        unsafe { self.device.device_wait_idle() }.vk("vkDeviceWaitIdle")
+        unsafe { self.device.queue_wait_idle(self.queue) }.vk("vkQueueWaitIdle")
     }
 
-    /// Destroys the device and instance; validation reports any object still alive into the log,
-    /// which stays readable afterwards. Runs once; `Drop` calls it too.
+    /// Destroys our objects, then the device and instance if we own them; validation reports
+    /// any object still alive into the log, which stays readable afterwards. Runs once; `Drop`
+    /// calls it too.
     pub fn destroy(&mut self) {
         if std::mem::replace(&mut self.destroyed, true) {
             return;
         }
         unsafe {
-            // Nothing to do on failure: the device is being torn down regardless.
-            let _ = self.device.device_wait_idle();
+            // Nothing to do on failure: our objects are being torn down regardless.
+            let _ = self.device.queue_wait_idle(self.queue);
             self.device.destroy_sampler(self.nearest_sampler, None);
-            ManuallyDrop::drop(&mut self.allocator);
-            self.device.destroy_device(None);
-            if let Some((loader, messenger)) = self.messenger.take() {
-                loader.destroy_debug_utils_messenger(messenger, None);
+            self.allocator = None;
+            if self.ownership == Ownership::Owned {
+                self.device.destroy_device(None);
+                if let Some((loader, messenger)) = self.messenger.take() {
+                    loader.destroy_debug_utils_messenger(messenger, None);
+                }
+                self.instance.destroy_instance(None);
             }
-            self.instance.destroy_instance(None);
         }
     }
 }
@@ -321,54 +432,6 @@ impl Drop for InstanceGuard {
             }
         }
     }
-}
-
-fn name_of(props: &vk::PhysicalDeviceProperties) -> String {
-    props.device_name_as_c_str().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
-}
-
-fn driver_of(instance: &ash::Instance, physical: vk::PhysicalDevice) -> String {
-    let mut driver = vk::PhysicalDeviceDriverProperties::default();
-    let mut props2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-    unsafe { instance.get_physical_device_properties2(physical, &mut props2) };
-    let name = driver.driver_name_as_c_str().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let info = driver.driver_info_as_c_str().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    format!("{name} {info}").trim().to_string()
-}
-
-/// A real GPU when present, lavapipe otherwise; `wanted` (a name substring) overrides.
-fn pick_device(
-    instance: &ash::Instance,
-    wanted: Option<&str>,
-) -> Result<(vk::PhysicalDevice, vk::PhysicalDeviceProperties)> {
-    let devices = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
-    let usable: Vec<_> = devices
-        .into_iter()
-        .map(|d| (d, unsafe { instance.get_physical_device_properties(d) }))
-        .filter(|(d, p)| {
-            let exts = unsafe { instance.enumerate_device_extension_properties(*d) }.unwrap_or_default();
-            p.api_version >= vk::API_VERSION_1_3
-                && exts.iter().any(|e| e.extension_name_as_c_str() == Ok(ash::khr::push_descriptor::NAME))
-        })
-        .collect();
-    if usable.is_empty() {
-        return Err(Error::NoDevice(format!("no Vulkan 1.3 device with VK_KHR_push_descriptor: {INSTALL_HINT}")));
-    }
-    if let Some(wanted) = wanted {
-        let lower = wanted.to_lowercase();
-        return usable.iter().find(|(_, p)| name_of(p).to_lowercase().contains(&lower)).copied().ok_or_else(|| {
-            let names: Vec<_> = usable.iter().map(|(_, p)| name_of(p)).collect();
-            Error::NoDevice(format!("SOFTSHADOW_DEVICE={wanted} matches no device (have: {})", names.join(", ")))
-        });
-    }
-    let rank = |t: vk::PhysicalDeviceType| match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 3,
-        _ => 4,
-    };
-    Ok(*usable.iter().min_by_key(|(_, p)| rank(p.device_type)).expect("non-empty"))
 }
 
 #[cfg(test)]

@@ -33,6 +33,26 @@ pub struct Frame<'a> {
     pub timer: &'a mut PassTimer,
 }
 
+/// Binary semaphores a submission waits on before the stage given with each, and signals once
+/// the stage given with each is done: the caller hands them in (hypermine's `draw.rs`), so a
+/// frame renders the same whatever it renders to.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Semaphores<'a> {
+    pub wait: &'a [(vk::Semaphore, vk::PipelineStageFlags2)],
+    pub signal: &'a [(vk::Semaphore, vk::PipelineStageFlags2)],
+}
+
+impl Semaphores<'static> {
+    /// Neither waits nor signals: offscreen frames ordered by the queue alone.
+    pub const NONE: Semaphores<'static> = Semaphores { wait: &[], signal: &[] };
+}
+
+fn semaphore_infos(list: &[(vk::Semaphore, vk::PipelineStageFlags2)]) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
+    list.iter()
+        .map(|&(semaphore, stage)| vk::SemaphoreSubmitInfo::default().semaphore(semaphore).stage_mask(stage))
+        .collect()
+}
+
 impl FrameRing {
     pub fn new(ctx: &Context) -> Result<Self> {
         let pool_ci = vk::CommandPoolCreateInfo::default()
@@ -85,14 +105,18 @@ impl FrameRing {
         Ok((Frame { slot, cmd: s.cmd, timer: &mut s.timer }, earlier))
     }
 
-    /// Ends and submits the frame begun last.
-    pub fn submit(&mut self, ctx: &Context, slot: usize) -> Result<()> {
+    /// Ends and submits the frame begun last, waiting on and signalling `semaphores`.
+    pub fn submit(&mut self, ctx: &Context, slot: usize, semaphores: &Semaphores) -> Result<()> {
         let s = &mut self.slots[slot];
+        let (wait, signal) = (semaphore_infos(semaphores.wait), semaphore_infos(semaphores.signal));
         unsafe {
             ctx.device.end_command_buffer(s.cmd).vk("vkEndCommandBuffer")?;
             ctx.device.reset_fences(&[s.fence]).vk("vkResetFences")?;
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(s.cmd)];
-            let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
+            let submit = [vk::SubmitInfo2::default()
+                .wait_semaphore_infos(&wait)
+                .command_buffer_infos(&cmds)
+                .signal_semaphore_infos(&signal)];
             ctx.device.queue_submit2(ctx.queue, &submit, s.fence).vk("vkQueueSubmit2")?;
         }
         s.timer.submitted();
@@ -160,7 +184,7 @@ mod tests {
         let slot = frame.slot;
         frame.timer.begin(&ctx, frame.cmd, "work");
         frame.timer.end(&ctx, frame.cmd);
-        ring.submit(&ctx, slot).unwrap();
+        ring.submit(&ctx, slot, &Semaphores::NONE).unwrap();
         let timings = ring.wait(&ctx, slot).unwrap().expect("the submitted frame has timings");
         assert_eq!(timings[0].name, "work");
         ring.destroy(&ctx);

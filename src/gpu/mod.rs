@@ -1,9 +1,11 @@
-//! The only Vulkan plumbing: context, memory, targets, barriers, pipelines, shaders,
-//! timestamps, frames and readback. Nothing here knows about shadows.
+//! The only Vulkan plumbing: context (own or the embedder's handles), memory, targets (own or
+//! wrapped), barriers, pipelines, shaders, timestamps, frames and readback. Nothing here knows
+//! about shadows.
 
 mod barrier;
 mod context;
 mod debug;
+mod device;
 mod frames;
 mod guard;
 mod memory;
@@ -16,8 +18,9 @@ mod timestamps;
 mod upload;
 
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
-pub use context::{Context, ContextOptions, DeviceInfo};
-pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing};
+pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership};
+pub use device::{DeviceFilter, required_device_extensions, required_vulkan13_features};
+pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing, Semaphores};
 pub use guard::{Destroy, Guard};
 pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, Variants, VertexInput};
@@ -27,4 +30,4 @@ pub use render::{
 };
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
-pub use upload::{copy_to_target, upload};
+pub use upload::{copy_to_buffer, copy_to_target, upload};

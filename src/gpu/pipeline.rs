@@ -478,7 +478,10 @@ impl Pipeline {
             .collect();
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, self.bind_point, self.pipeline);
-            ctx.push_descriptor.cmd_push_descriptor_set(cmd, self.bind_point, self.layout, 0, &writes);
+            // A pipeline whose shaders declare nothing has no set to push.
+            if !writes.is_empty() {
+                ctx.push_descriptor.cmd_push_descriptor_set(cmd, self.bind_point, self.layout, 0, &writes);
+            }
         }
         Ok(())
     }

@@ -25,6 +25,14 @@ impl<'a> Attachment<'a> {
         }
     }
 
+    /// A depth-stencil attachment cleared to `depth` and `stencil`.
+    pub fn clear_depth_stencil(target: &'a Target, depth: f32, stencil: u32) -> Self {
+        Attachment {
+            target,
+            clear: Some(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth, stencil } }),
+        }
+    }
+
     fn info(&self) -> vk::RenderingAttachmentInfo<'static> {
         vk::RenderingAttachmentInfo::default()
             .image_view(self.target.view)
@@ -40,7 +48,8 @@ pub struct RenderPass;
 
 impl RenderPass {
     /// Begins rendering into `colors` and `depth` (all the same size, already transitioned) and
-    /// sets the viewport and scissor to cover them.
+    /// sets the viewport and scissor to cover them. A `depth` target with a stencil aspect is the
+    /// stencil attachment too.
     pub fn begin(
         ctx: &Context,
         cmd: vk::CommandBuffer,
@@ -49,13 +58,19 @@ impl RenderPass {
     ) -> Self {
         let extent = colors.first().or(depth.as_ref()).expect("a pass draws into something").target.extent();
         let color_infos: Vec<_> = colors.iter().map(Attachment::info).collect();
-        let depth_info = depth.as_ref().map(Attachment::info);
+        let depth_info = depth.as_ref().map(|d| (d.info(), d.target.desc.aspect()));
         let mut info = vk::RenderingInfo::default()
             .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
             .layer_count(1)
             .color_attachments(&color_infos);
-        if let Some(d) = &depth_info {
-            info = info.depth_attachment(d);
+        if let Some((d, aspect)) = &depth_info {
+            if aspect.contains(vk::ImageAspectFlags::DEPTH) {
+                info = info.depth_attachment(d);
+            }
+            // Dynamic rendering clears, loads and stores the stencil aspect only through this.
+            if aspect.contains(vk::ImageAspectFlags::STENCIL) {
+                info = info.stencil_attachment(d);
+            }
         }
         let viewport = vk::Viewport {
             x: 0.0,

@@ -1,5 +1,6 @@
 //! Render targets, declared by description (kajiya's `ImageDesc`, Granite's `render_target`)
-//! and carrying their last access so barriers are derived, not guessed.
+//! or wrapped from images made elsewhere, and carrying their last access so barriers are
+//! derived, not guessed.
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -39,36 +40,59 @@ impl TargetDesc {
         }
     }
 
+    /// A depth-stencil attachment of `format`, which is the context's
+    /// [`depth_stencil_format`](Context::depth_stencil_format).
+    pub fn depth_stencil(name: &'static str, format: vk::Format, width: u32, height: u32) -> Self {
+        TargetDesc { format, ..TargetDesc::depth(name, width, height) }
+    }
+
     /// Adds usages (`SAMPLED` to read a depth target, `TRANSFER_SRC` to read one back).
     pub fn usage(mut self, extra: vk::ImageUsageFlags) -> Self {
         self.usage |= extra;
         self
     }
 
+    /// The aspects of the format: what barriers, views and attachments cover.
     pub fn aspect(&self) -> vk::ImageAspectFlags {
-        if self.format == vk::Format::D32_SFLOAT { vk::ImageAspectFlags::DEPTH } else { vk::ImageAspectFlags::COLOR }
+        match self.format {
+            vk::Format::D16_UNORM | vk::Format::X8_D24_UNORM_PACK32 | vk::Format::D32_SFLOAT => {
+                vk::ImageAspectFlags::DEPTH
+            }
+            vk::Format::D16_UNORM_S8_UINT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT => {
+                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
+            }
+            vk::Format::S8_UINT => vk::ImageAspectFlags::STENCIL,
+            _ => vk::ImageAspectFlags::COLOR,
+        }
     }
 }
 
-/// An image, its view and memory, and the access that last touched it.
+/// What a target created, and so what `destroy` destroys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Owns {
+    /// Image, view and memory.
+    Everything,
+    /// A view of a wrapped image.
+    View,
+    /// Nothing: image and view are wrapped.
+    Nothing,
+}
+
+/// An image, its view and memory (our own, or wrapped), and the access that last touched it.
 pub struct Target {
     pub desc: TargetDesc,
     pub(crate) image: vk::Image,
     pub(crate) view: vk::ImageView,
     allocation: Option<Allocation>,
+    owns: Owns,
     pub(crate) last: Access,
 }
 
 impl Target {
+    /// Creates an image and view of `desc` in memory of its own.
     pub fn new(ctx: &Context, desc: TargetDesc) -> Result<Self> {
-        let max = ctx.info.max_image_dimension_2d;
+        check_extent(ctx, &desc)?;
         let vk::Extent2D { width, height } = desc.extent;
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(Error::Invalid(format!(
-                "{} target of {width}x{height}: each side must lie in 1..={max} on {}",
-                desc.name, ctx.info.name
-            )));
-        }
         let ci = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
@@ -88,7 +112,14 @@ impl Target {
             linear: false,
             allocation_scheme: AllocationScheme::GpuAllocatorManaged,
         };
-        let mut target = Target { desc, image, view: vk::ImageView::null(), allocation: None, last: Access::NONE };
+        let mut target = Target {
+            desc,
+            image,
+            view: vk::ImageView::null(),
+            allocation: None,
+            owns: Owns::Everything,
+            last: Access::NONE,
+        };
         match ctx.allocate(&alloc_desc) {
             Ok(a) => target.allocation = Some(a),
             Err(e) => {
@@ -101,36 +132,54 @@ impl Target {
             target.destroy(ctx);
             return Err(Error::Vulkan { call: "vkBindImageMemory", result });
         }
-        let view_ci = vk::ImageViewCreateInfo::default()
-            .image(image)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(desc.format)
-            .subresource_range(subresource(desc.aspect()));
-        match unsafe { ctx.device.create_image_view(&view_ci, None) } {
+        match create_view(ctx, image, &desc) {
             Ok(v) => target.view = v,
-            Err(result) => {
+            Err(e) => {
                 target.destroy(ctx);
-                return Err(Error::Vulkan { call: "vkCreateImageView", result });
+                return Err(e);
             }
         }
         ctx.name(image, desc.name);
-        ctx.name(target.view, desc.name);
         Ok(target)
+    }
+
+    /// Wraps an image created elsewhere (a swapchain image, the embedder's depth buffer) of
+    /// `desc`, now in `current`, with its `view` or else a view made here. `destroy` then
+    /// destroys only a view made here; barriers treat the image like one of our own.
+    pub fn wrap(
+        ctx: &Context,
+        desc: TargetDesc,
+        image: vk::Image,
+        view: Option<vk::ImageView>,
+        current: Access,
+    ) -> Result<Self> {
+        check_extent(ctx, &desc)?;
+        let (view, owns) = match view {
+            Some(v) => (v, Owns::Nothing),
+            None => (create_view(ctx, image, &desc)?, Owns::View),
+        };
+        Ok(Target { desc, image, view, allocation: None, owns, last: current })
     }
 
     pub fn extent(&self) -> vk::Extent2D {
         self.desc.extent
     }
 
-    /// A copy between all of this image and tightly packed texels at `buffer_offset`.
+    /// A copy between all of this image and tightly packed texels at `buffer_offset` (a color
+    /// or depth target; a depth-stencil one copies an aspect at a time, with [`Target::aspect_copy`]).
     pub fn whole_copy(&self, buffer_offset: u64) -> vk::BufferImageCopy {
+        self.aspect_copy(self.desc.aspect(), buffer_offset)
+    }
+
+    /// A copy between `aspect` of all of this image and tightly packed texels at `buffer_offset`.
+    pub fn aspect_copy(&self, aspect: vk::ImageAspectFlags, buffer_offset: u64) -> vk::BufferImageCopy {
         let extent = self.extent();
         vk::BufferImageCopy {
             buffer_offset,
             buffer_row_length: 0,
             buffer_image_height: 0,
             image_subresource: vk::ImageSubresourceLayers {
-                aspect_mask: self.desc.aspect(),
+                aspect_mask: aspect,
                 mip_level: 0,
                 base_array_layer: 0,
                 layer_count: 1,
@@ -140,15 +189,43 @@ impl Target {
         }
     }
 
+    /// Destroys what this target created: for a wrapped image, at most the view made for it.
     pub fn destroy(mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_image_view(self.view, None);
-            ctx.device.destroy_image(self.image, None);
+            if self.owns != Owns::Nothing {
+                ctx.device.destroy_image_view(self.view, None);
+            }
+            if self.owns == Owns::Everything {
+                ctx.device.destroy_image(self.image, None);
+            }
         }
         if let Some(a) = self.allocation.take() {
             ctx.free(a);
         }
     }
+}
+
+fn check_extent(ctx: &Context, desc: &TargetDesc) -> Result<()> {
+    let max = ctx.info.max_image_dimension_2d;
+    let vk::Extent2D { width, height } = desc.extent;
+    if width == 0 || height == 0 || width > max || height > max {
+        return Err(Error::Invalid(format!(
+            "{} target of {width}x{height}: each side must lie in 1..={max} on {}",
+            desc.name, ctx.info.name
+        )));
+    }
+    Ok(())
+}
+
+fn create_view(ctx: &Context, image: vk::Image, desc: &TargetDesc) -> Result<vk::ImageView> {
+    let view_ci = vk::ImageViewCreateInfo::default()
+        .image(image)
+        .view_type(vk::ImageViewType::TYPE_2D)
+        .format(desc.format)
+        .subresource_range(subresource(desc.aspect()));
+    let view = unsafe { ctx.device.create_image_view(&view_ci, None) }.vk("vkCreateImageView")?;
+    ctx.name(view, desc.name);
+    Ok(view)
 }
 
 pub(crate) fn subresource(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {

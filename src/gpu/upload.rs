@@ -1,5 +1,5 @@
-//! One-time uploads of static data (meshes) into device-local buffers, and per-frame copies of
-//! CPU-computed images into targets.
+//! One-time uploads of static data (meshes) into device-local buffers, per-frame copies of
+//! CPU-computed images into targets, and copies of targets out for readback.
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -101,4 +101,16 @@ pub fn copy_to_target(ctx: &Context, cmd: vk::CommandBuffer, src: vk::Descriptor
             &[region],
         )
     };
+}
+
+/// Records copies of `regions` of `target` (already transitioned to [`Access::COPY_READ`]) into
+/// `dst`; [`copy_to_host`](super::copy_to_host) then makes them visible to the host.
+pub fn copy_to_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    target: &Target,
+    dst: &Buffer,
+    regions: &[vk::BufferImageCopy],
+) {
+    unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, target.image, target.last.layout, dst.buffer, regions) };
 }

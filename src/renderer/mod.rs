@@ -403,7 +403,7 @@ impl Engine {
         }
         let slot = frame.slot;
         let frames = self.frames.as_mut().expect("engine is built");
-        frames.submit(ctx, slot)?;
+        frames.submit(ctx, slot, &crate::gpu::Semaphores::NONE)?;
         clock.mark(SUBMIT);
         self.push_timings(earlier);
         if !capture {
