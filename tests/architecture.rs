@@ -81,6 +81,27 @@ fn geometry_and_scene_know_no_vulkan() {
     }
 }
 
+/// Vulkan calls are the gpu room's: above it, techniques and the renderer go through its
+/// helpers (passes, barriers, copies), so no `unsafe` appears there.
+#[test]
+fn only_gpu_calls_vulkan() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    for room in ["frame", "technique", "renderer", "measure", "reference", "scene", "geometry"] {
+        let mut files = BTreeMap::new();
+        imports(&src.join(room), &mut files);
+        for file in files.keys() {
+            let text = std::fs::read_to_string(file).unwrap();
+            for (i, line) in text.lines().enumerate() {
+                assert!(
+                    !line.contains("unsafe") && !line.contains("ctx.device."),
+                    "{file}:{}: Vulkan outside gpu",
+                    i + 1
+                );
+            }
+        }
+    }
+}
+
 /// The rule has teeth: the scanner sees an import that breaks it.
 #[test]
 fn the_scanner_finds_a_forbidden_import() {

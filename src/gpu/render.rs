@@ -121,10 +121,16 @@ pub fn fullscreen(
     let pass = RenderPass::begin(ctx, cmd, &[Attachment { target, clear: None }], None);
     let bound = pipeline.bind(ctx, cmd, inputs);
     if bound.is_ok() {
-        unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+        draw_fullscreen(ctx, cmd);
     }
     pass.end(ctx, cmd);
     bound
+}
+
+/// Draws the full-screen triangle of `glsl/common/fullscreen.vert` with the bound pipeline,
+/// inside a pass the caller began (one that loads what earlier passes wrote).
+pub fn draw_fullscreen(ctx: &Context, cmd: vk::CommandBuffer) {
+    unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
 }
 
 /// Draws `count` vertices of the tightly packed vertex buffer range `vertices` from `first`

@@ -10,7 +10,7 @@ use super::CameraTargets;
 use crate::error::{Error, Result};
 use crate::frame::{RAW_VISIBILITY_FORMAT, ShadowRole, Surfaces, quantize};
 use crate::geometry::CameraProjection;
-use crate::gpu::{Buffer, Context};
+use crate::gpu::{Buffer, Context, copy_to_buffer};
 
 /// Bytes per pixel read back: RGBA8 color, D32 depth, RGBA16F normal + receives, then V: R16,
 /// or R32F for raw visibility.
@@ -28,16 +28,7 @@ pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTar
     let mut offset = 0;
     let bytes = pixel_bytes(t.visibility.desc.format);
     for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
-        let region = target.whole_copy(offset);
-        unsafe {
-            ctx.device.cmd_copy_image_to_buffer(
-                cmd,
-                target.image,
-                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                dst.buffer,
-                &[region],
-            )
-        };
+        copy_to_buffer(ctx, cmd, target, dst, &[target.whole_copy(offset)]);
         offset += pixels * bytes;
     }
 }

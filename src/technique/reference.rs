@@ -27,7 +27,7 @@ use crate::frame::interface::{LightSample, LightView};
 use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, Milestones, PerFrame,
-    Pipeline, RenderPass, Target, TargetDesc, ensure, shaders, transition,
+    Pipeline, RenderPass, Target, TargetDesc, draw_fullscreen, ensure, shaders, transition,
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -208,7 +208,7 @@ impl Technique for Reference {
                     Descriptor::Image(atlas),
                 ],
             )?;
-            unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+            draw_fullscreen(ctx, cmd);
             pass.end(ctx, cmd);
             milestones.mark(ctx, cmd);
         }
