@@ -25,12 +25,13 @@ pub enum Error {
     /// GPU memory could not be allocated.
     #[error("GPU memory allocation failed: {0}")]
     Memory(#[from] gpu_allocator::AllocationError),
-    /// A file could not be read or written.
-    #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    /// A file could not be read or written. (The cause is part of the message, not a
+    /// `source`, so that a report of the whole chain does not print it twice.)
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
     /// An image could not be encoded.
-    #[error("{}: {source}", path.display())]
-    Image { path: PathBuf, source: image::ImageError },
+    #[error("{}: {error}", path.display())]
+    Image { path: PathBuf, error: image::ImageError },
 }
 
 impl Error {

@@ -160,7 +160,7 @@ fn a_nan_transform_is_an_error_not_a_nan_image() {
     s.objects[0].transform.position.y = f32::NAN;
     let mut e = engine();
     let err = e.render(&s, &settings(&s, 32, 32)).unwrap_err().to_string();
-    assert!(err.contains("object 0"), "{err}");
+    assert!(err.contains("[[object]] 1 (box1)") && err.contains("`position`") && err.contains("NaN"), "{err}");
     finish(e);
 }
 

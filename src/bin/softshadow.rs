@@ -342,6 +342,7 @@ fn finish(engine: Engine) -> Result<()> {
 
 fn render(args: &RenderArgs) -> Result<TimingReport> {
     let (scene, settings) = load(&args.what)?;
+    writable(&[&args.out, &args.visibility, &args.timings, &args.trace])?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
     let mut trace = args.trace.as_ref().map(|_| Trace::new(&engine.device().name));
     let label = serde_json::json!({
@@ -367,9 +368,21 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
     Ok(report)
 }
 
+/// Fails now, before a long render, when an output file's folder does not exist.
+fn writable(paths: &[&Option<PathBuf>]) -> Result<()> {
+    for path in paths.iter().copied().flatten() {
+        let folder = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        if !folder.is_dir() {
+            bail!("{}: the folder {} does not exist", path.display(), folder.display());
+        }
+    }
+    Ok(())
+}
+
 /// `compare`: the technique's metrics against a ground truth on the same camera pixels.
 fn compare(args: &CompareArgs) -> Result<()> {
     let (scene, settings) = load(&args.what)?;
+    writable(&[&args.diff])?;
     let against = args.against.as_deref().map_or(Ok(ground_truth(Runs::Gpu)), find)?;
     if !matches!(against.kind, Kind::GroundTruth(_)) {
         let truths: Vec<_> =

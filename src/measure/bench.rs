@@ -200,7 +200,7 @@ pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
             passes.join(" ")
         );
     }
-    std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+    std::fs::write(path, out).map_err(|error| Error::Io { path: path.into(), error })
 }
 
 /// Per scene, a table sorted by cost with the Pareto-optimal rows marked.
@@ -242,7 +242,7 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         }
         out += "\n";
     }
-    std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+    std::fs::write(path, out).map_err(|error| Error::Io { path: path.into(), error })
 }
 
 /// Per technique and setting, the medians over the scenes and on how many scenes the row is
@@ -294,7 +294,7 @@ pub fn save_reference(capture: &Capture, path: &Path) -> Result<()> {
         }
         bytes.push(u8::from(s.receives[i]));
     }
-    std::fs::write(path, bytes).map_err(|source| Error::Io { path: path.into(), source })
+    std::fs::write(path, bytes).map_err(|error| Error::Io { path: path.into(), error })
 }
 
 /// A capture stored by [`save_reference`], if `path` holds one of `width` × `height`.

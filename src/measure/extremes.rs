@@ -373,5 +373,5 @@ pub fn write_csv(rows: &[ExtremeRow], path: &Path) -> Result<()> {
             opt(r.truth_step)
         );
     }
-    std::fs::write(path, out).map_err(|source| Error::Io { path: path.into(), source })
+    std::fs::write(path, out).map_err(|error| Error::Io { path: path.into(), error })
 }

@@ -133,7 +133,7 @@ pub fn save_difference(v: &Capture, reference: &Capture, path: &Path) -> Result<
         rgb.extend(pixel);
     }
     image::save_buffer(path, &rgb, v.width, v.height, image::ExtendedColorType::Rgb8)
-        .map_err(|source| Error::Image { path: path.into(), source })
+        .map_err(|error| Error::Image { path: path.into(), error })
 }
 
 #[cfg(test)]

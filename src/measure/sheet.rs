@@ -53,5 +53,5 @@ pub fn contact_sheet(tiles: &[Tile], columns: usize, path: &Path) -> Result<()> 
         root.present().map_err(|e| plot_error(path, e))?;
     }
     image::save_buffer(path, &rgb, sheet_w, sheet_h, image::ExtendedColorType::Rgb8)
-        .map_err(|source| Error::Image { path: path.into(), source })
+        .map_err(|error| Error::Image { path: path.into(), error })
 }

@@ -121,7 +121,7 @@ impl Trace {
 
     pub fn write(&self, path: &Path) -> Result<()> {
         let text = self.to_json().to_string();
-        std::fs::write(path, text).map_err(|source| Error::Io { path: path.into(), source })
+        std::fs::write(path, text).map_err(|error| Error::Io { path: path.into(), error })
     }
 }
 

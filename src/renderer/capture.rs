@@ -125,14 +125,14 @@ impl Capture {
 
     pub fn save_color(&self, path: &Path) -> Result<()> {
         image::save_buffer(path, &self.color, self.width, self.height, image::ExtendedColorType::Rgba8)
-            .map_err(|source| Error::Image { path: path.into(), source })
+            .map_err(|error| Error::Image { path: path.into(), error })
     }
 
     /// The 16-bit grayscale PNG of DESIGN.md §3.
     pub fn save_visibility(&self, path: &Path) -> Result<()> {
         let img = image::ImageBuffer::<image::Luma<u16>, _>::from_raw(self.width, self.height, self.visibility.clone())
             .expect("buffer matches its size");
-        img.save(path).map_err(|source| Error::Image { path: path.into(), source })
+        img.save(path).map_err(|error| Error::Image { path: path.into(), error })
     }
 }
 

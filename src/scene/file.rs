@@ -8,7 +8,10 @@ use std::sync::Arc;
 use glam::Vec3;
 use serde::Deserialize;
 
-use super::{Camera, Ground, KnobSetting, Light, Mesh, Object, RenderSettings, Scene, Transform, primitives};
+use super::read::{MAX_SCENE_BYTES, clip_lines, read_limited};
+use super::{
+    Camera, Ground, KnobSetting, Light, MAX_COORDINATE, Mesh, Object, RenderSettings, Scene, Transform, primitives,
+};
 use crate::error::{Error, Result};
 use crate::geometry::Projection;
 
@@ -27,9 +30,9 @@ struct SceneFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraFile {
-    position: [f32; 3],
-    target: [f32; 3],
-    up: Option<[f32; 3]>,
+    position: Triple,
+    target: Triple,
+    up: Option<Triple>,
     fov_y_deg: Option<f32>,
     ortho_half_height: Option<f32>,
 }
@@ -37,9 +40,9 @@ struct CameraFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct LightFile {
-    position: [f32; 3],
+    position: Triple,
     radius: f32,
-    target: Option<[f32; 3]>,
+    target: Option<Triple>,
 }
 
 #[derive(Deserialize)]
@@ -69,7 +72,7 @@ enum Shape {
 #[serde(untagged)]
 enum Scale {
     Uniform(f32),
-    PerAxis([f32; 3]),
+    PerAxis(Triple),
 }
 
 #[derive(Deserialize)]
@@ -77,16 +80,16 @@ enum Scale {
 struct ObjectFile {
     shape: Shape,
     name: Option<String>,
-    size: Option<[f32; 3]>,
+    size: Option<Triple>,
     radius: Option<f32>,
     height: Option<f32>,
     mesh: Option<String>,
     #[serde(default)]
-    position: [f32; 3],
+    position: Triple,
     #[serde(default)]
-    rotation_deg: [f32; 3],
+    rotation_deg: Triple,
     scale: Option<Scale>,
-    color: Option<[f32; 3]>,
+    color: Option<Triple>,
     #[serde(default = "yes")]
     casts: bool,
     #[serde(default = "yes")]
@@ -95,6 +98,25 @@ struct ObjectFile {
 
 fn yes() -> bool {
     true
+}
+
+/// Three numbers, exactly: a fixed-size array would ignore extra elements.
+#[derive(Deserialize, Clone, Copy, Default)]
+#[serde(try_from = "Vec<f32>")]
+struct Triple([f32; 3]);
+
+impl TryFrom<Vec<f32>> for Triple {
+    type Error = String;
+
+    fn try_from(v: Vec<f32>) -> std::result::Result<Self, String> {
+        <[f32; 3]>::try_from(v.as_slice()).map(Triple).map_err(|_| format!("expected 3 numbers, got {}", v.len()))
+    }
+}
+
+impl From<Triple> for Vec3 {
+    fn from(t: Triple) -> Vec3 {
+        Vec3::from(t.0)
+    }
 }
 
 #[derive(Deserialize, Default)]
@@ -118,16 +140,17 @@ const PALETTE: [[f32; 3]; 6] = [
 ];
 
 pub(super) fn load(path: &Path) -> Result<Scene> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| Error::scene(path, format!("cannot read the scene file: {e}")))?;
+    let bytes = read_limited(path, MAX_SCENE_BYTES, "scene file")?;
+    let text = String::from_utf8(bytes).map_err(|e| Error::scene(path, format!("not UTF-8 text: {e}")))?;
     parse(&text, path)
 }
 
 pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
     // toml's message names the line, the column and the offending key.
-    let file: SceneFile = toml::from_str(text).map_err(|e| Error::scene(path, e.to_string().trim_end().to_string()))?;
+    let file: SceneFile =
+        toml::from_str(text).map_err(|e| Error::scene(path, clip_lines(e.to_string().trim_end(), 200)))?;
     let err = |what: String| Error::scene(path, what);
-    let finite = |key: &str, v: [f32; 3]| -> Result<Vec3> {
+    let finite = |key: &str, v: Triple| -> Result<Vec3> {
         let v = Vec3::from(v);
         if v.is_finite() { Ok(v) } else { Err(err(format!("`{key}` must be finite numbers, got {v}"))) }
     };
@@ -142,7 +165,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
     let camera = Camera {
         position: finite("camera.position", c.position)?,
         target: finite("camera.target", c.target)?,
-        up: finite("camera.up", c.up.unwrap_or([0.0, 1.0, 0.0]))?,
+        up: finite("camera.up", c.up.unwrap_or(Triple([0.0, 1.0, 0.0])))?,
         projection,
     };
     let light = Light {
@@ -157,7 +180,10 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<Scene> {
         .objects
         .iter()
         .enumerate()
-        .map(|(i, o)| object(o, i, base).map_err(|what| err(format!("[[object]] {} ({:?}): {what}", i + 1, o.shape))))
+        .map(|(i, o)| {
+            let name = o.name.clone().unwrap_or_else(|| format!("{:?}", o.shape).to_lowercase());
+            object(o, i, base).map_err(|what| err(format!("[[object]] {} ({name}): {what}", i + 1)))
+        })
         .collect::<Result<Vec<_>>>()?;
 
     // The technique and its knobs are checked by the frame settings, which know the
@@ -207,7 +233,11 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
     };
     let positive = |key: &str, v: Option<f32>| -> std::result::Result<f32, String> {
         let v = v.ok_or(format!("needs `{key}`"))?;
-        if v > 0.0 && v.is_finite() { Ok(v) } else { Err(format!("`{key}` must be positive, got {v}")) }
+        if v > 0.0 && v <= MAX_COORDINATE {
+            Ok(v)
+        } else {
+            Err(format!("`{key}` must lie in (0, {MAX_COORDINATE:e}] m, got {v}"))
+        }
     };
     let (size, radius, height, mesh_key) = (o.size.is_some(), o.radius.is_some(), o.height.is_some(), o.mesh.is_some());
     let mesh = match o.shape {
@@ -216,8 +246,10 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
             let s = Vec3::from(o.size.ok_or("needs `size = [x, y, z]`")?);
             // A plate may be infinitely thin; a box may not.
             let min_y = if o.shape == Shape::Plate { 0.0 } else { f32::MIN_POSITIVE };
-            if !(s.is_finite() && s.x > 0.0 && s.z > 0.0 && s.y >= min_y) {
-                return Err(format!("`size` must be positive (a plate's y may be 0), got {s}"));
+            if !(s.max_element() <= MAX_COORDINATE && s.x > 0.0 && s.z > 0.0 && s.y >= min_y) {
+                return Err(format!(
+                    "`size` must be positive (a plate's y may be 0) and at most {MAX_COORDINATE:e} m, got {s}"
+                ));
             }
             primitives::cuboid(s)
         }
@@ -247,7 +279,7 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
         name,
         mesh: Arc::new(mesh),
         transform,
-        color: Vec3::from(o.color.unwrap_or(PALETTE[index % PALETTE.len()])),
+        color: o.color.map_or(Vec3::from(PALETTE[index % PALETTE.len()]), Vec3::from),
         casts: o.casts,
         receives: o.receives,
         sphere_radius: if o.shape == Shape::Sphere { o.radius } else { None },

@@ -6,12 +6,16 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::Vec3;
 
+use super::read::{MAX_OBJ_BYTES, MAX_OBJ_LINE, overlong_line, read_limited};
 use crate::error::{Error, Result};
 use crate::geometry::{Aabb, EdgeAdjacency};
 
 /// Identifies a mesh for the GPU cache; unique for the life of the process.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MeshId(u64);
+
+/// The most triangles a mesh may have: ten times the largest model the suite measures.
+pub const MAX_TRIANGLES: usize = 1 << 24;
 
 /// Normals of faces meeting at a vertex at more than this angle stay split (hard edges).
 const CREASE_COS: f32 = 0.766; // cos 40°: keeps box and cylinder rims sharp, spheres smooth
@@ -43,17 +47,35 @@ impl Mesh {
     /// Builds a mesh from positions and triangles, welding identical positions.
     pub fn new(name: impl Into<String>, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self> {
         let name = name.into();
-        let invalid = |what: String| Error::Invalid(format!("mesh {name}: {what}"));
+        Mesh::build(name.clone(), positions, triangles).map_err(|what| Error::Invalid(format!("mesh {name}: {what}")))
+    }
+
+    /// [`Mesh::new`], failing with the bare reason (callers name the mesh their own way).
+    fn build(name: String, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> std::result::Result<Self, String> {
         if triangles.is_empty() {
-            return Err(invalid("has no triangles".into()));
+            return Err("has no triangles".into());
         }
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(invalid(format!("vertex {i} is not a finite number")));
+            return Err(format!("vertex {i} is not a finite number"));
         }
         if let Some(t) = triangles.iter().position(|t| t.iter().any(|&v| v as usize >= positions.len())) {
-            return Err(invalid(format!("triangle {t} indexes past the {} vertices", positions.len())));
+            return Err(format!("triangle {t} indexes past the {} vertices", positions.len()));
         }
-        let (positions, triangles) = weld(&positions, &triangles);
+        let (positions, mut triangles) = weld(&positions, &triangles);
+        // Points, lines and faces of one or two corners arrive as triangles repeating a vertex:
+        // they have no area and no edges of their own.
+        let given = triangles.len();
+        triangles.retain(|[a, b, c]| a != b && b != c && a != c);
+        let has_area = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            (b - a).cross(c - a) != Vec3::ZERO
+        };
+        if !triangles.iter().any(has_area) {
+            return Err(format!(
+                "none of its {given} faces has area ({} repeat a vertex: points, lines or faces of one or two corners)",
+                given - triangles.len()
+            ));
+        }
         let bounds = Aabb::from_points(positions.iter().copied());
         let adjacency = EdgeAdjacency::build(&triangles);
         static NEXT: AtomicU64 = AtomicU64::new(0);
@@ -61,15 +83,18 @@ impl Mesh {
         Ok(Mesh { id, name, positions, triangles, adjacency, bounds })
     }
 
-    /// Loads every object of an OBJ file into one mesh (triangulated).
+    /// Loads every object of an OBJ file into one mesh (triangulated), within the limits of
+    /// [`MAX_OBJ_BYTES`](super::MAX_OBJ_BYTES), [`MAX_OBJ_LINE`](super::MAX_OBJ_LINE) and
+    /// [`MAX_TRIANGLES`]. Materials are not read: only the shape casts shadows.
     pub fn load_obj(path: &Path) -> Result<Self> {
+        let bytes = read_limited(path, MAX_OBJ_BYTES, "mesh file")?;
+        if let Some(line) = overlong_line(&bytes, MAX_OBJ_LINE) {
+            return Err(Error::scene(path, format!("line {line} is longer than {MAX_OBJ_LINE} bytes")));
+        }
         let options = tobj::LoadOptions { triangulate: true, single_index: false, ..Default::default() };
-        let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| match e {
-            tobj::LoadError::OpenFileFailed | tobj::LoadError::ReadError => {
-                Error::scene(path, "cannot open or read the mesh file")
-            }
-            other => Error::scene(path, format!("not a valid OBJ file: {other}")),
-        })?;
+        let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
+        let (models, _materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, no_materials)
+            .map_err(|e| Error::scene(path, format!("not a valid OBJ file: {e}")))?;
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
         for model in &models {
@@ -80,7 +105,10 @@ impl Mesh {
         if triangles.is_empty() {
             return Err(Error::scene(path, "the OBJ file holds no triangles"));
         }
-        Mesh::new(path.display().to_string(), positions, triangles).map_err(|e| Error::scene(path, e.to_string()))
+        if triangles.len() > MAX_TRIANGLES {
+            return Err(Error::scene(path, format!("{} triangles, more than {MAX_TRIANGLES}", triangles.len())));
+        }
+        Mesh::build(path.display().to_string(), positions, triangles).map_err(|what| Error::scene(path, what))
     }
 
     pub fn id(&self) -> MeshId {
@@ -95,37 +123,77 @@ impl Mesh {
 
     /// Vertices and indices for drawing: normals averaged across smooth edges and split across
     /// creases sharper than 40°, so boxes stay faceted and spheres smooth from one code path.
+    /// The corners of the faces around a vertex that are joined by smooth edges share one
+    /// normal, the area-weighted sum of their faces'; found with a union-find over corners, so
+    /// the cost is linear in the triangles however many meet at a vertex.
     pub fn render_geometry(&self) -> (Vec<Vertex>, Vec<u32>) {
         let face_normals: Vec<Vec3> = (0..self.triangles.len()).map(|f| self.face_normal(f)).collect();
-        let mut faces_at: Vec<Vec<u32>> = vec![Vec::new(); self.positions.len()];
+        let unit: Vec<Vec3> = face_normals.iter().map(|n| n.normalize_or_zero()).collect();
+        let corner = |f: usize, v: u32| 3 * f + self.triangles[f].iter().position(|&u| u == v).expect("v is a corner");
+        let mut faces_of_edge: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
         for (f, tri) in self.triangles.iter().enumerate() {
-            for &v in tri {
-                faces_at[v as usize].push(f as u32);
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                faces_of_edge.entry((a.min(b), a.max(b))).or_default().push(f);
             }
         }
+        let mut corners = UnionFind::new(3 * self.triangles.len());
+        for ((a, b), faces) in &faces_of_edge {
+            for pair in faces.windows(2) {
+                let (f, g) = (pair[0], pair[1]);
+                if unit[f].dot(unit[g]) >= CREASE_COS {
+                    corners.union(corner(f, *a), corner(g, *a));
+                    corners.union(corner(f, *b), corner(g, *b));
+                }
+            }
+        }
+        let mut sums = vec![Vec3::ZERO; 3 * self.triangles.len()];
+        for c in 0..sums.len() {
+            sums[corners.find(c)] += face_normals[c / 3];
+        }
+        let mut vertex_of = vec![u32::MAX; sums.len()];
         let mut vertices = Vec::new();
         let mut indices = Vec::with_capacity(self.triangles.len() * 3);
-        let mut lookup: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
         for (f, tri) in self.triangles.iter().enumerate() {
-            let own = face_normals[f].normalize_or_zero();
-            for &v in tri {
-                let sum: Vec3 = faces_at[v as usize]
-                    .iter()
-                    .map(|&g| face_normals[g as usize])
-                    .filter(|n| n.normalize_or_zero().dot(own) >= CREASE_COS)
-                    .sum();
-                // A degenerate fan has no direction; any unit normal keeps the shader NaN-free.
-                let normal = sum.try_normalize().or(own.try_normalize()).unwrap_or(Vec3::Y);
-                let key = (v, normal.to_array().map(f32::to_bits));
-                let index = *lookup.entry(key).or_insert_with(|| {
+            for (k, &v) in tri.iter().enumerate() {
+                let root = corners.find(3 * f + k);
+                if vertex_of[root] == u32::MAX {
+                    // A degenerate fan has no direction; any unit normal keeps the shader NaN-free.
+                    let normal = sums[root].try_normalize().or(unit[f].try_normalize()).unwrap_or(Vec3::Y);
                     vertices
                         .push(Vertex { position: self.positions[v as usize].to_array(), normal: normal.to_array() });
-                    vertices.len() as u32 - 1
-                });
-                indices.push(index);
+                    vertex_of[root] = vertices.len() as u32 - 1;
+                }
+                indices.push(vertex_of[root]);
             }
         }
         (vertices, indices)
+    }
+}
+
+/// Disjoint sets of indices, with path halving.
+struct UnionFind {
+    parent: Vec<usize>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind { parent: (0..n).collect() }
+    }
+
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.parent[i] != i {
+            self.parent[i] = self.parent[self.parent[i]];
+            i = self.parent[i];
+        }
+        i
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (self.find(a), self.find(b));
+        if a != b {
+            self.parent[a.max(b)] = a.min(b);
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 mod file;
 mod mesh;
 pub mod primitives;
+mod read;
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -13,7 +14,13 @@ use crate::error::{Error, Result};
 use crate::geometry::Aabb;
 pub use crate::geometry::Projection;
 pub use crate::geometry::{Edge, EdgeAdjacency, NO_FACE};
-pub use mesh::{Mesh, MeshId, Vertex};
+pub use mesh::{MAX_TRIANGLES, Mesh, MeshId, Vertex};
+pub use read::{MAX_OBJ_BYTES, MAX_OBJ_LINE, MAX_SCENE_BYTES};
+
+/// How far from the origin any point of a scene may lie, in metres (a million kilometres):
+/// room for a light 1e8 m away, while squared distances stay far inside f32's range. Scene
+/// files and game loops are checked against it.
+pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Where the camera is and how it projects.
 #[derive(Clone, Debug, PartialEq)]
@@ -167,19 +174,21 @@ impl Scene {
         file::parse(text, path.as_ref())
     }
 
-    /// Checks what a game loop may have changed since loading: every number finite, sizes
-    /// positive, the camera well defined, the light above the ground.
+    /// Checks what a game loop may have changed since loading: every number finite and within
+    /// [`MAX_COORDINATE`], sizes positive, the camera well defined, the light above the ground.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::Invalid(what));
         let c = &self.camera;
-        for (name, v) in [
+        let mut points = vec![
             ("camera.position", c.position),
             ("camera.target", c.target),
             ("camera.up", c.up),
             ("light.position", self.light.position),
-        ] {
-            if !v.is_finite() {
-                return bad(format!("{name} is not finite: {v}"));
+        ];
+        points.extend(self.light.target.map(|t| ("light.target", t)));
+        for (name, v) in points {
+            if !(v.is_finite() && v.abs().max_element() <= MAX_COORDINATE) {
+                return bad(format!("`{name}` must be finite numbers within ±{MAX_COORDINATE:e} m, got {v}"));
             }
         }
         let forward = c.target - c.position;
@@ -205,12 +214,18 @@ impl Scene {
         if !(l.radius >= 0.0 && l.radius.is_finite()) {
             return bad(format!("light.radius must be zero or positive, got {}", l.radius));
         }
-        if let Some(t) = l.target.filter(|t| !t.is_finite()) {
-            return bad(format!("light.target is not finite: {t}"));
+        if l.radius > MAX_COORDINATE {
+            return bad(format!("`light.radius` must be at most {MAX_COORDINATE:e} m, got {}", l.radius));
         }
         if let Some(g) = &self.ground {
-            if !(g.height.is_finite() && g.half_size > 0.0 && g.half_size.is_finite()) {
-                return bad(format!("ground needs a finite height and a positive half_size, got {g:?}"));
+            if !(g.height.is_finite() && g.height.abs() <= MAX_COORDINATE) {
+                return bad(format!(
+                    "`ground.height` must be a finite number within ±{MAX_COORDINATE:e} m, got {}",
+                    g.height
+                ));
+            }
+            if !(g.half_size > 0.0 && g.half_size <= MAX_COORDINATE) {
+                return bad(format!("`ground.half_size` must lie in (0, {MAX_COORDINATE:e}] m, got {}", g.half_size));
             }
             if l.position.y - l.radius <= g.height {
                 return bad(format!(
@@ -221,11 +236,26 @@ impl Scene {
         }
         for (i, o) in self.objects.iter().enumerate() {
             let t = &o.transform;
-            if !(t.position.is_finite() && t.rotation_deg.is_finite() && o.color.is_finite()) {
-                return bad(format!("object {i} ({}): position, rotation or color is not finite", o.name));
+            let object = |what: String| bad(format!("[[object]] {} ({}): {what}", i + 1, o.name));
+            for (key, v) in [("position", t.position), ("rotation_deg", t.rotation_deg)] {
+                if !(v.is_finite() && v.abs().max_element() <= MAX_COORDINATE) {
+                    return object(format!("`{key}` must be finite numbers within ±{MAX_COORDINATE:e}, got {v}"));
+                }
+            }
+            // An albedo: the fraction of light reflected.
+            if !(o.color.cmpge(Vec3::ZERO).all() && o.color.cmple(Vec3::ONE).all()) {
+                return object(format!("`color` must lie in [0, 1], got {}", o.color));
             }
             if !(t.scale.is_finite() && t.scale.cmpgt(Vec3::ZERO).all()) {
-                return bad(format!("object {i} ({}): scale must be positive, got {}", o.name, t.scale));
+                return object(format!("`scale` must be positive, got {}", t.scale));
+            }
+            let bounds = o.bounds();
+            let reach = bounds.min.abs().max(bounds.max.abs()).max_element();
+            if reach > MAX_COORDINATE {
+                return object(format!(
+                    "reaches {reach:e} m from the origin (position {}, scale {}): the limit is ±{MAX_COORDINATE:e} m",
+                    t.position, t.scale
+                ));
             }
         }
         if self.render.width == 0 || self.render.height == 0 {
