@@ -39,4 +39,16 @@ bool hides_itself(Surface s, vec3 q) {
     return s.casts && dot(s.n, q - s.p) <= 0.0;
 }
 
+// The same for a spherical light (centre `c`, radius `radius`): the fraction of it that lies in
+// front of a caster's tangent plane, 1 for surfaces that cast nothing. The light seen from p is
+// a disk of angular radius a whose centre stands b above the horizon; the plane cuts it at
+// h = sin b / sin a of its radius, leaving the circular segment 1 - (acos h - h sqrt(1 - h^2)) / pi.
+float in_front_of_itself(Surface s, vec3 c, float radius) {
+    if (!s.casts) return 1.0;
+    vec3 to_light = c - s.p;
+    float dist = length(to_light);
+    float h = clamp(dot(s.n, to_light) / max(radius, 1e-6 * dist), -1.0, 1.0);
+    return 1.0 - (acos(h) - h * sqrt(1.0 - h * h)) / 3.14159265;
+}
+
 #endif

@@ -47,4 +47,54 @@ float compare_bilinear(sampler2D atlas, vec2 origin, float size, vec2 uv, float 
     return mix(top, bottom, f.y);
 }
 
+// The receiver's tangent plane in light view space, for lookups whose footprint is wide enough
+// to reach the receiver's own surface (PCSS). A map texel holds the point d·(tx, ty, 1) of the
+// nearest caster along its centre's ray; that point can hide part of the light from the
+// receiver only if it lies on the light's side of the receiver's tangent plane (the segment
+// from the receiver to any point of the light above that plane stays above it). Testing the
+// texel's point against the plane, instead of the texel's depth against the receiver's one
+// depth, is the receiver plane depth bias of Isidoro ("Shadow Mapping: GPU-based Tips and
+// Techniques", GDC 2006) made exact: the plane comes from the prepass's facet normal, not from
+// screen-space derivatives, so it holds at silhouettes and across a fullscreen resolve.
+struct ReceiverPlane {
+    vec3 p;       // the receiver, light view space
+    vec3 n;       // its facet normal there, turned towards the light's centre (the origin)
+    float margin; // world distance in front of the plane below which a texel is the receiver's own
+};
+
+ReceiverPlane receiver_plane(LightView light, vec3 p, vec3 n) {
+    ReceiverPlane r;
+    r.p = (light.view * vec4(p, 1.0)).xyz;
+    r.n = mat3(light.view) * n; // the view is rigid
+    if (dot(r.n, r.p) > 0.0) r.n = -r.n;
+    // The constant depth bias (texels at the receiver): the depth map's own rounding.
+    r.margin = light.bias.x * r.p.z * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
+    return r;
+}
+
+// Whether `depth`, stored at `texel` of the light's size x size map, is a caster point in front
+// of the receiver's plane. Beyond the margin, 2e-3 per unit of distance from the receiver
+// absorbs the normal's half-float rounding (about 1e-3 per component).
+bool in_front_of(LightView light, ReceiverPlane r, vec2 texel, float depth) {
+    if (depth > 1e30) return false; // cleared: nothing there
+    vec2 t = light.extent.xy + (texel + 0.5) / light.bias.w * (light.extent.zw - light.extent.xy);
+    vec3 b = depth * vec3(t, 1.0);
+    return dot(r.n, b - r.p) > r.margin + 2e-3 * distance(b, r.p);
+}
+
+// compare_bilinear against the receiver's plane instead of one depth (1 = lit).
+float compare_bilinear_plane(sampler2D map, LightView light, ReceiverPlane r, vec2 uv) {
+    float size = light.bias.w;
+    vec2 texel_pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
+    vec2 f = fract(texel_pos);
+    vec2 i0 = floor(texel_pos);
+    // Gathering at the corner shared by the four texels: (i0,j1) (i1,j1) (i1,j0) (i0,j0).
+    vec4 d = textureGather(map, (i0 + 1.0) / vec2(textureSize(map, 0)), 0);
+    vec4 lit = vec4(!in_front_of(light, r, i0 + vec2(0.0, 1.0), d.x), !in_front_of(light, r, i0 + vec2(1.0, 1.0), d.y),
+                    !in_front_of(light, r, i0 + vec2(1.0, 0.0), d.z), !in_front_of(light, r, i0, d.w));
+    float top = mix(lit.w, lit.z, f.x);
+    float bottom = mix(lit.x, lit.y, f.x);
+    return mix(top, bottom, f.y);
+}
+
 #endif

@@ -60,17 +60,35 @@ float pcf_bicubic(sampler2D map, LightView light, ShadowLookup l) {
     return lit;
 }
 
+// PCF over a disk like pcf_disk, each tap compared against the receiver's plane.
+float pcf_disk_plane(sampler2D map, LightView light, ReceiverPlane r, vec2 centre, float radius_texels, int n) {
+    float size = light.bias.w;
+    float angle = pixel_rotation();
+    float lit = 0.0;
+    for (int i = 0; i < n; i++) {
+        lit += compare_bilinear_plane(map, light, r, centre + vogel(i, n, angle) * radius_texels / size);
+    }
+    return lit / float(n);
+}
+
 // PCSS: average the depths of the blockers in the region the light could be hidden from,
 // estimate the penumbra from similar triangles, and PCF over it (Fernando 2005).
-// `z`: the receiver's linear light depth. light.kernel: filter taps, light radius R (world),
-// the frustum's near depth, blocker taps.
-float pcss(sampler2D map, LightView light, ShadowLookup l, float z) {
+// `p`, `n`: the receiver and its facet normal (world). light.kernel: filter taps, light radius R
+// (world), the frustum's near depth, blocker taps.
+//
+// Both the search and the filter reach far beyond the few texels a depth bias covers, so on a
+// surface slanted to the light they would find the receiver's own surface in front of its one
+// depth: a lit face of a caster came out at V ~ 0.7 (issue 19). Both test map texels against
+// the receiver's tangent plane instead (ReceiverPlane, glsl/common/shadow.glsl).
+float pcss(sampler2D map, LightView light, ShadowLookup l, vec3 p, vec3 n) {
     float size = light.bias.w;
     float radius = light.kernel.y;
     float near = light.kernel.z;
     int taps = max(int(light.kernel.x), 1);
     int blocker_taps = max(int(light.kernel.w), 1);
     float per_tangent = texels_per_tangent(light).x;
+    ReceiverPlane r = receiver_plane(light, p, n);
+    float z = r.p.z;
     // 1. Blocker search. A blocker at depth zb hides part of the light from the receiver when it
     //    lies within R (z - zb) / (z zb) of the receiver's direction (tangent units): widest for
     //    the nearest depth the map holds, `near`. Capped at a quarter of the map.
@@ -79,9 +97,9 @@ float pcss(sampler2D map, LightView light, ShadowLookup l, float z) {
     float sum = 0.0;
     int found = 0;
     for (int i = 0; i < blocker_taps; i++) {
-        vec2 texel = l.uv * size + vogel(i, blocker_taps, angle) * search;
-        float d = texelFetch(map, ivec2(clamp(texel, vec2(0.0), vec2(size - 1.0))), 0).r;
-        if (d < l.depth) {
+        vec2 texel = floor(clamp(l.uv * size + vogel(i, blocker_taps, angle) * search, vec2(0.0), vec2(size - 1.0)));
+        float d = texelFetch(map, ivec2(texel), 0).r;
+        if (in_front_of(light, r, texel, d)) {
             sum += d;
             found++;
         }
@@ -92,12 +110,12 @@ float pcss(sampler2D map, LightView light, ShadowLookup l, float z) {
     float blocker = sum / float(found);
     // 2. Penumbra by similar triangles: w = R (z - zb) / zb at the receiver (world), that is
     //    R (z - zb) / (zb z) in tangent units.
-    float filter_texels = radius * (z - blocker) / (blocker * z) * per_tangent;
+    float filter_texels = radius * max(z - blocker, 0.0) / (blocker * z) * per_tangent;
     // 3. PCF over it; below half a texel it is the bilinear hard edge (contact hardening).
     if (filter_texels < 0.5) {
-        return compare_bilinear(map, vec2(0.0), size, l.uv, l.depth);
+        return compare_bilinear_plane(map, light, r, l.uv);
     }
-    return pcf_disk(map, light, l, filter_texels, taps);
+    return pcf_disk_plane(map, light, r, l.uv, filter_texels, taps);
 }
 
 #endif

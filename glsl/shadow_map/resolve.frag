@@ -52,6 +52,9 @@ void main() {
     } else if (FILTER == BICUBIC) {
         out_visibility = pcf_bicubic(shadow_map, light, l);
     } else {
-        out_visibility = pcss(shadow_map, light, l, (light.view * vec4(s.p, 1.0)).z);
+        // The receiver-plane tests of pcss() leave a caster's own surface out of the map, so the
+        // part of the light below its tangent plane is taken out here (the soft hides_itself).
+        float self_lit = in_front_of_itself(s, frame.light.xyz, light.kernel.y);
+        out_visibility = self_lit * pcss(shadow_map, light, l, s.p, s.n);
     }
 }

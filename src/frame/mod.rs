@@ -66,6 +66,12 @@ impl ShadowRole {
     pub fn receives(encoded: f32) -> bool {
         encoded > 0.25
     }
+
+    /// Whether an encoded role is [`ShadowRole::ReceivesAndCasts`]: above halfway between 0.5
+    /// and 1.
+    pub fn casts(encoded: f32) -> bool {
+        encoded > 0.75
+    }
 }
 
 /// One object to draw this frame: its uploaded mesh and its index in the object buffer.
@@ -99,6 +105,8 @@ pub struct Surfaces {
     pub normal: Vec<Vec3>,
     /// The surface receives shadows (V means something there).
     pub receives: Vec<bool>,
+    /// The surface receives shadows and belongs to a caster (it may shadow itself).
+    pub casts: Vec<bool>,
 }
 
 /// What a technique reads while it records one frame.
@@ -131,6 +139,7 @@ mod tests {
         for (receives, casts) in [(false, false), (false, true), (true, false), (true, true)] {
             let role = ShadowRole::new(receives, casts);
             assert_eq!(ShadowRole::receives(role.encode()), receives, "{role:?}");
+            assert_eq!(ShadowRole::casts(role.encode()), receives && casts, "{role:?}");
         }
     }
 }

@@ -292,7 +292,8 @@ pub fn save_reference(capture: &Capture, path: &Path) -> Result<()> {
         for c in s.normal[i].to_array() {
             bytes.extend(c.to_le_bytes());
         }
-        bytes.push(u8::from(s.receives[i]));
+        // Bit 0: receives, bit 1: casts (caches written before casts was kept read as 0).
+        bytes.push(u8::from(s.receives[i]) | (u8::from(s.casts[i]) << 1));
     }
     std::fs::write(path, bytes).map_err(|error| Error::Io { path: path.into(), error })
 }
@@ -317,13 +318,15 @@ pub fn load_reference(path: &Path, width: u32, height: u32) -> Option<Capture> {
             depth: Vec::with_capacity(n),
             normal: Vec::with_capacity(n),
             receives: Vec::with_capacity(n),
+            casts: Vec::with_capacity(n),
         },
     };
     for p in bytes[8..].chunks_exact(PIXEL) {
         capture.visibility.push(u16::from_le_bytes([p[0], p[1]]));
         capture.surfaces.depth.push(f32_at(&p[2..]));
         capture.surfaces.normal.push(glam::Vec3::new(f32_at(&p[6..]), f32_at(&p[10..]), f32_at(&p[14..])));
-        capture.surfaces.receives.push(p[18] != 0);
+        capture.surfaces.receives.push(p[18] & 1 != 0);
+        capture.surfaces.casts.push(p[18] & 2 != 0);
     }
     Some(capture)
 }

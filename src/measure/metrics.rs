@@ -152,6 +152,7 @@ mod tests {
                 depth: depth.to_vec(),
                 normal: vec![glam::Vec3::Y; v.len()],
                 receives: receives.to_vec(),
+                casts: vec![false; v.len()],
             },
         }
     }

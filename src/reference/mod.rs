@@ -134,14 +134,16 @@ impl TraceScene {
         let mut depth = vec![f32::INFINITY; n];
         let mut normal = vec![Vec3::ZERO; n];
         let mut receives = vec![false; n];
+        let mut cast = vec![false; n];
         let row = width as usize;
         visibility
             .par_chunks_mut(row)
             .zip(depth.par_chunks_mut(row))
             .zip(normal.par_chunks_mut(row))
             .zip(receives.par_chunks_mut(row))
+            .zip(cast.par_chunks_mut(row))
             .enumerate()
-            .for_each(|(y, (((v_row, d_row), n_row), r_row))| {
+            .for_each(|(y, ((((v_row, d_row), n_row), r_row), c_row))| {
                 for x in 0..width as usize {
                     let index = y * width as usize + x;
                     let uv = Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
@@ -161,12 +163,13 @@ impl TraceScene {
                     }
                     r_row[x] = true;
                     let caster = self.casts[self.object_of[tri as usize] as usize];
+                    c_row[x] = caster;
                     let surface = Surface { point: p + facing * self.epsilon, solid_side: caster.then_some(facing) };
                     v_row[x] = shade(surface, index);
                 }
                 progress();
             });
-        TracedImage { visibility, surfaces: Surfaces { depth, normal, receives } }
+        TracedImage { visibility, surfaces: Surfaces { depth, normal, receives, casts: cast } }
     }
 
     /// Whether a caster crosses the segment from `origin` along unit `dir` for `length`.

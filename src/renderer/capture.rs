@@ -107,7 +107,9 @@ impl Capture {
             })
             .collect();
         // The normal target's alpha (a half float) is the shadow role.
-        let receives = parts[2].chunks_exact(8).map(|b| ShadowRole::receives(half_to_f32(halfs(b)[3]))).collect();
+        let role: Vec<f32> = parts[2].chunks_exact(8).map(|b| half_to_f32(halfs(b)[3])).collect();
+        let receives = role.iter().map(|&r| ShadowRole::receives(r)).collect();
+        let casts = role.iter().map(|&r| ShadowRole::casts(r)).collect();
         let (visibility, raw_visibility) = if visibility_format == RAW_VISIBILITY_FORMAT {
             let raw: Vec<f32> =
                 parts[3].chunks_exact(4).map(|b| f32::from_ne_bytes([b[0], b[1], b[2], b[3]])).collect();
@@ -115,7 +117,14 @@ impl Capture {
         } else {
             (parts[3].chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]])).collect(), None)
         };
-        Capture { width, height, color, visibility, raw_visibility, surfaces: Surfaces { depth, normal, receives } }
+        Capture {
+            width,
+            height,
+            color,
+            visibility,
+            raw_visibility,
+            surfaces: Surfaces { depth, normal, receives, casts },
+        }
     }
 
     /// V at pixel (x, y) in [0, 1].

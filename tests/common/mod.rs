@@ -119,3 +119,79 @@ pub fn shadow_centroid(c: &softshadow::Capture) -> Option<(f32, f32)> {
     }
     (n > 0.0).then(|| (sx / n, sy / n))
 }
+
+/// The CPU ray tracer with 256 shadow rays per pixel: the truth the lit-caster checks use
+/// (exact on the caster's own faces, where a shadow map's self-comparisons are the suspect).
+pub fn traced(e: &mut Engine, s: &Scene, size: u32) -> Capture {
+    render_with(e, s, "raytrace", &[("samples", "256")], size)
+}
+
+/// Lit caster pixels a technique darkens: among the pixels where both renders see the same
+/// facet (depths within 0.1 %, normals within cos 0.99) of a surface that casts and receives,
+/// and `truth` sees fully lit (V ≥ 0.99), how many `v` gives V < 0.8.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LitCasters {
+    /// Lit caster pixels compared.
+    pub of: usize,
+    /// Of those, the ones `v` darkens.
+    pub darkened: usize,
+    /// Darkened pixels away from any edge: all eight neighbours are lit caster pixels too (a
+    /// pixel beside a silhouette, a shadow or the terminator may be darkened by the sampling of
+    /// a map or a rasterizer, not by a wrong estimate).
+    pub interior: usize,
+}
+
+impl LitCasters {
+    pub fn rate(&self) -> f64 {
+        if self.of == 0 { 0.0 } else { self.darkened as f64 / self.of as f64 }
+    }
+}
+
+pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
+    assert_eq!((v.width, v.height), (truth.width, truth.height), "same size");
+    let (a, b) = (&v.surfaces, &truth.surfaces);
+    let lit: Vec<bool> = (0..v.visibility.len())
+        .map(|i| {
+            let (da, db) = (a.depth[i], b.depth[i]);
+            let same = (da - db).abs() <= 1e-3 * da.max(db) && a.normal[i].dot(b.normal[i]) >= 0.99;
+            a.casts[i] && b.casts[i] && same && truth.visibility[i] >= (0.99 * 65535.0) as u16
+        })
+        .collect();
+    let (w, h) = (v.width as i64, v.height as i64);
+    let mut m = LitCasters::default();
+    for (i, _) in lit.iter().enumerate().filter(|(_, l)| **l) {
+        m.of += 1;
+        if v.visibility[i] >= (0.8 * 65535.0) as u16 {
+            continue;
+        }
+        m.darkened += 1;
+        let (x, y) = (i as i64 % w, i as i64 / w);
+        let inside = |dx: i64, dy: i64| {
+            let (nx, ny) = (x + dx, y + dy);
+            (0..w).contains(&nx) && (0..h).contains(&ny) && lit[(ny * w + nx) as usize]
+        };
+        m.interior += usize::from((-1..=1).all(|dy| (-1..=1).all(|dx| inside(dx, dy))));
+    }
+    m
+}
+
+/// Penumbra RMSE against `truth` (0.02 < V_truth < 0.98) split by role: (receivers that cast
+/// nothing, e.g. the ground; casters), each with its pixel count, over the pixels where both
+/// renders see the same facet.
+pub fn penumbra_rmse_by_role(v: &Capture, truth: &Capture) -> [(f64, usize); 2] {
+    let (a, b) = (&v.surfaces, &truth.surfaces);
+    let mut acc = [(0.0, 0); 2];
+    for i in 0..v.visibility.len() {
+        let (da, db) = (a.depth[i], b.depth[i]);
+        let same = (da - db).abs() <= 1e-3 * da.max(db) && a.normal[i].dot(b.normal[i]) >= 0.99;
+        let r = truth.visibility[i] as f64 / 65535.0;
+        if !(a.receives[i] && b.receives[i] && same && a.casts[i] == b.casts[i] && 0.02 < r && r < 0.98) {
+            continue;
+        }
+        let e = v.visibility[i] as f64 / 65535.0 - r;
+        let slot = &mut acc[usize::from(a.casts[i])];
+        slot.0 += e * e;
+        slot.1 += 1;
+    }
+    acc.map(|(sq, n)| (if n == 0 { 0.0 } else { (sq / n as f64).sqrt() }, n))
+}
