@@ -123,31 +123,3 @@ fn pcss_keeps_the_lit_faces_of_casters_lit() {
     }
     finish(e);
 }
-
-#[test]
-#[ignore = "measurement: prints lit-caster darkening and penumbra RMSE, asserts nothing"]
-fn measure_lit_casters() {
-    let mut e = engine();
-    for name in ["open_mesh", "torus", "wingnut", "default"] {
-        let s = suite_scene(name);
-        let size = std::env::var("LIT_CASTER_SIZE").map_or(128, |v| v.parse().unwrap());
-        let truth = common::traced(&mut e, &s, size);
-        let reference = common::reference(&mut e, &s, size);
-        for t in ["shadow-map", "pcf", "pcss", "smoothie", "parker", "reference"] {
-            let c = render_with(&mut e, &s, t, &[], size);
-            let lc = common::lit_casters(&c, &truth);
-            let (d, of) = (lc.darkened, lc.of);
-            let m = Metrics::between(&c, &reference).unwrap();
-            let [(g, gn), (k, kn)] = common::penumbra_rmse_by_role(&c, &truth);
-            let [(rg, _), (rk, rkn)] = common::penumbra_rmse_by_role(&c, &reference);
-            println!(
-                "{name:10} {t:10} darkened {d:5}/{of:5} = {:5.1}% (interior {})  vs reference: penumbra RMSE {:.4} RMSE {:.4}; vs raytrace penumbra: ground {g:.4} /{gn}, casters {k:.4} /{kn}; vs reference: ground {rg:.4}, casters {rk:.4} /{rkn}",
-                100.0 * d as f64 / of.max(1) as f64,
-                lc.interior,
-                m.penumbra_rmse,
-                m.rmse,
-            );
-        }
-    }
-    finish(e);
-}

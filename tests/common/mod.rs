@@ -175,23 +175,3 @@ pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
     m
 }
 
-/// Penumbra RMSE against `truth` (0.02 < V_truth < 0.98) split by role: (receivers that cast
-/// nothing, e.g. the ground; casters), each with its pixel count, over the pixels where both
-/// renders see the same facet.
-pub fn penumbra_rmse_by_role(v: &Capture, truth: &Capture) -> [(f64, usize); 2] {
-    let (a, b) = (&v.surfaces, &truth.surfaces);
-    let mut acc = [(0.0, 0); 2];
-    for i in 0..v.visibility.len() {
-        let (da, db) = (a.depth[i], b.depth[i]);
-        let same = (da - db).abs() <= 1e-3 * da.max(db) && a.normal[i].dot(b.normal[i]) >= 0.99;
-        let r = truth.visibility[i] as f64 / 65535.0;
-        if !(a.receives[i] && b.receives[i] && same && a.casts[i] == b.casts[i] && 0.02 < r && r < 0.98) {
-            continue;
-        }
-        let e = v.visibility[i] as f64 / 65535.0 - r;
-        let slot = &mut acc[usize::from(a.casts[i])];
-        slot.0 += e * e;
-        slot.1 += 1;
-    }
-    acc.map(|(sq, n)| (if n == 0 { 0.0 } else { (sq / n as f64).sqrt() }, n))
-}
