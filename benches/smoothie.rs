@@ -24,7 +24,7 @@ fn smoothie(c: &mut Criterion) {
     // The light view a frame would fit: around the model, cut to a ground square under it.
     let bounds = Aabb::from_points(positions.iter().copied());
     let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
-    let frustum = fit_spot_frustum(light, bounds.center(), &bounds.corners(), &ground).expect("the model is in view");
+    let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
     let view = frustum.view;
     let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, frustum.far);
     let mut mailbox = Mailbox::default();

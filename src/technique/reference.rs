@@ -19,12 +19,14 @@ use glam::{Vec3, Vec4};
 
 use super::knobs::{Knob, Params};
 use super::registry::{Kind, Runs, SweepKnobs, TechniqueInfo};
-use super::shadow_map::{DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, depth_pipeline, draw_casters};
+use super::shadow_map::{
+    DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, caster_bounds, depth_pipeline, draw_casters, warn_clipped,
+};
 use super::{Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::{LightSample, LightView};
-use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
+use crate::geometry::{cap_points, fit_spot_frustum, visible_cap};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, Milestones, PerFrame,
     Pipeline, RenderPass, Target, TargetDesc, draw_fullscreen, ensure, shaders, transition,
@@ -98,8 +100,7 @@ impl Reference {
     /// The light samples of this frame, each with its fitted frustum.
     fn light_samples(frame: &FrameInputs<'_>, n: usize, size: u32) -> Vec<LightSample> {
         let light = &frame.scene.light;
-        let casters: Vec<Vec3> = frame.draws.iter().filter(|d| d.casts).flat_map(|d| d.bounds.corners()).collect();
-        let aim = light.target.unwrap_or_else(|| Aabb::from_points(casters.iter().copied()).center());
+        let casters = caster_bounds(frame);
         // A point light has one point to sample.
         let points = if light.radius > 0.0 {
             let cap = visible_cap(light.position, light.radius, frame.receivers_in_view);
@@ -107,10 +108,13 @@ impl Reference {
         } else {
             vec![light.position]
         };
-        points
+        let mut clipped = Vec::new();
+        let samples = points
             .into_iter()
             .map(|q| {
-                let frustum = fit_spot_frustum(q, aim, &casters, frame.receivers_in_view);
+                let fit = fit_spot_frustum(q, light.target, &casters, frame.receivers_in_view);
+                clipped.extend(fit.clipped);
+                let frustum = fit.frustum;
                 let view = frustum.map_or(LightView::zeroed(), |f| LightView {
                     view: f.view,
                     view_proj: f.view_proj,
@@ -121,7 +125,11 @@ impl Reference {
                 let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
                 LightSample { view, position: q.extend(has_map), pad: [Vec4::ZERO; 4] }
             })
-            .collect()
+            .collect();
+        clipped.sort_unstable();
+        clipped.dedup();
+        warn_clipped(frame, &clipped);
+        samples
     }
 }
 

@@ -11,7 +11,7 @@
 
 use ash::vk;
 use bytemuck::bytes_of;
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 
 use super::knobs::{Knob, Params};
 use super::registry::{Kind, SweepKnobs, TechniqueInfo};
@@ -150,6 +150,42 @@ pub(crate) fn depth_pipeline(ctx: &Context, format: vk::Format) -> Result<Pipeli
     Pipeline::new(ctx, &desc)
 }
 
+/// The world bounds of the frame's casters, in draw order.
+pub(crate) fn caster_bounds(frame: &FrameInputs<'_>) -> Vec<Aabb> {
+    frame.draws.iter().filter(|d| d.casts).map(|d| d.bounds).collect()
+}
+
+/// Says which casters (indices into [`caster_bounds`]) lost part of their shadow in view to
+/// the frustum's 160° limit (a light among its casters), once per change of the list: a
+/// shadow is never dropped without a word.
+pub(crate) fn warn_clipped(frame: &FrameInputs<'_>, clipped: &[usize]) {
+    static LAST: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let casting: Vec<_> = frame.draws.iter().filter(|d| d.casts).collect();
+    let names: Vec<String> = clipped
+        .iter()
+        .map(|&i| {
+            let instance = casting[i].instance as usize;
+            frame
+                .scene
+                .objects
+                .get(instance)
+                .map_or(format!("caster {i}"), |o| format!("object {instance} ({})", o.name))
+        })
+        .collect();
+    let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
+    if *last != names {
+        if !names.is_empty() {
+            eprintln!(
+                "softshadow warning: the light at {} is among its casters: the shadows of {} reach beyond the \
+                 160° one shadow-map frustum holds and are cut at its edge",
+                frame.scene.light.position,
+                names.join(", ")
+            );
+        }
+        *last = names;
+    }
+}
+
 /// Records every caster of the frame (inside a pass whose pipeline is bound).
 pub(crate) fn draw_casters(frame: &FrameInputs<'_>) {
     for draw in frame.draws.iter().filter(|d| d.casts) {
@@ -180,16 +216,15 @@ impl ShadowMapPass {
         self.format
     }
 
-    /// Fits the frustum; `None` when no receiver in view can be shadowed (nothing to render).
+    /// Fits the frustum to the casters that can shadow a receiver in view; `None` when there
+    /// are none (nothing to render). Casters one frustum cannot hold are named in a warning.
     pub fn fit(frame: &FrameInputs<'_>) -> Option<LightFrustum> {
-        let casters: Vec<Vec3> = frame.draws.iter().filter(|d| d.casts).flat_map(|d| d.bounds.corners()).collect();
-        if casters.is_empty() {
-            return None;
-        }
+        let casters = caster_bounds(frame);
         let light = &frame.scene.light;
-        // DESIGN.md §3: the spot looks at `light.target`, by default the casters' centre.
-        let aim = light.target.unwrap_or_else(|| Aabb::from_points(casters.iter().copied()).center());
-        fit_spot_frustum(light.position, aim, &casters, frame.receivers_in_view)
+        // DESIGN.md §3: the spot looks at `light.target`, a hint the fit re-centres on the casters.
+        let fit = fit_spot_frustum(light.position, light.target, &casters, frame.receivers_in_view);
+        warn_clipped(frame, &fit.clipped);
+        fit.frustum
     }
 
     /// Records the map; afterwards it is ready to be sampled by fragment shaders. `bias` and
