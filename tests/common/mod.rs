@@ -174,4 +174,3 @@ pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
     }
     m
 }
-
