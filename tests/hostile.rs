@@ -167,9 +167,10 @@ fn bad_obj_files_are_refused_by_name() {
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\n", "has area"),
         ("v 0 0 0\nv 1 0 0\nf 1 2\nf 1 1 2\n", "has area"),
         ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "has area"),
-        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "m.obj"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "line 4"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "line 4"),
         ("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "finite"),
-        ("v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj"),
+        ("v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "line 1"),
         ("\u{0}\u{1}binary", "m.obj"),
         ("", "no triangles"),
         (long_line.as_str(), "line 4"),
@@ -179,6 +180,11 @@ fn bad_obj_files_are_refused_by_name() {
         let e = e.unwrap_or_else(|| panic!("accepted an OBJ of {content:?}"));
         assert!(e.contains("m.obj") && e.contains(needle), "`{needle}` not named: {e}");
     }
+    // Found by tests/fuzz.rs: tobj multiplied this normal index and overflowed. Only the
+    // shape is read, so the face loads.
+    let overflow = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//99999999999999999999 2 3\n";
+    std::fs::write(dir.join("m.obj"), overflow).unwrap();
+    assert!(Scene::from_toml(&with_mesh, dir.join("s.toml")).is_ok());
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
-use softshadow::measure::{Metrics, TimingReport, Trace, save_difference};
+use softshadow::measure::{FileTrace, Metrics, TimingReport, save_difference};
 use softshadow::scene::Scene;
 use softshadow::technique::registry::{Runs, ground_truth};
 use softshadow::technique::{Kind, Params, TECHNIQUES, TechniqueInfo, find};
@@ -304,7 +304,7 @@ fn render_frames(
     scene: &Scene,
     settings: &FrameSettings,
     frames: Option<usize>,
-    trace: Option<(&mut Trace, &serde_json::Value)>,
+    trace: Option<(&mut FileTrace, &serde_json::Value)>,
 ) -> Result<(Capture, TimingReport)> {
     let offline = settings.params.technique.kind.offline();
     let frames = frames.unwrap_or(if offline { 1 } else { 20 });
@@ -312,6 +312,8 @@ fn render_frames(
         bail!("--frames must be at least 1");
     }
     let warmup = if offline { 0 } else { WARMUP_FRAMES };
+    // Every frame rendered here is reported (or traced): keep all their timings.
+    engine.set_timing_history(warmup + frames);
     for _ in 0..warmup + frames - 1 {
         engine.render(scene, settings)?;
     }
@@ -344,7 +346,7 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
     let (scene, settings) = load(&args.what)?;
     writable(&[&args.out, &args.visibility, &args.timings, &args.trace])?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    let mut trace = args.trace.as_ref().map(|_| Trace::new(&engine.device().name));
+    let mut trace = args.trace.as_ref().map(|p| FileTrace::create(&engine.device().name, p)).transpose()?;
     let label = serde_json::json!({
         "scene": args.what.scene,
         "technique": settings.params.technique.name,
@@ -352,8 +354,8 @@ fn render(args: &RenderArgs) -> Result<TimingReport> {
     });
     let (capture, report) =
         render_frames(&mut engine, &scene, &settings, args.what.frames, trace.as_mut().map(|t| (t, &label)))?;
-    if let (Some(trace), Some(p)) = (&trace, &args.trace) {
-        trace.write(p)?;
+    if let Some(trace) = trace {
+        trace.finish()?;
     }
     if let Some(p) = &args.out {
         capture.save_color(p)?;
@@ -503,7 +505,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
     let cache = args.out.join("cache");
     std::fs::create_dir_all(&cache).with_context(|| format!("creating {}", cache.display()))?;
     let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    let mut trace = args.trace.as_ref().map(|_| Trace::new(&engine.device().name));
+    let mut trace = args.trace.as_ref().map(|p| FileTrace::create(&engine.device().name, p)).transpose()?;
     let bar = indicatif::ProgressBar::new((scenes.len() * (runs.len() + 1)) as u64);
     let mut rows = Vec::new();
     for path in &scenes {
@@ -570,8 +572,8 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
     registry_cost_goals().iter().filter_map(|g| g.outcome(&rows)).for_each(|line| println!("{line}"));
-    if let (Some(trace), Some(p)) = (&trace, &args.trace) {
-        trace.write(p)?;
+    if let (Some(trace), Some(p)) = (trace, &args.trace) {
+        trace.finish()?;
         println!("wrote {}", p.display());
     }
     println!("wrote {0}/results.csv, {0}/report.md, {0}/tradeoff.png", args.out.display());

@@ -13,4 +13,4 @@ pub use metrics::{GROSS_ERROR, Metrics, PENUMBRA, save_difference};
 pub use plot::tradeoff;
 pub use sheet::{Tile, contact_sheet};
 pub use timings::{PassSummary, TimingReport};
-pub use trace::Trace;
+pub use trace::{FileTrace, Trace};

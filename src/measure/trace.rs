@@ -7,8 +7,13 @@
 //! timestamp onto the host's clock: the smallest that puts no frame's first pass before its
 //! submission. A GPU may start a pass's top-of-pipe before the previous pass drains; such
 //! overlaps are trimmed so that the GPU track's slices never overlap.
+//!
+//! CPU events are written to the file as frames finish; only a few numbers per GPU pass stay
+//! in memory until the end, so a trace of a long run does not grow the process by its size.
 
-use std::path::Path;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use serde_json::{Value, json};
@@ -20,42 +25,110 @@ const PID: u32 = 1;
 const CPU_TID: u32 = 1;
 const GPU_TID: u32 = 2;
 
-/// One frame's GPU passes, kept raw until the clock offset is known.
-struct GpuFrame {
+/// One GPU pass, kept as numbers until the clock offset is known (its labels are shared).
+struct GpuPass {
     frame: u64,
-    submitted_ms: f64,
-    passes: Vec<(&'static str, f64, f64)>,
-    args: Value,
+    label: usize,
+    name: &'static str,
+    begin_ms: f64,
+    ms: f64,
 }
 
-/// Trace events gathered over a run, written by [`Trace::write`].
-pub struct Trace {
+/// A trace being written: CPU events stream to the output as they come; GPU passes wait, a
+/// few numbers each, for [`Trace::finish`], since the clock offset depends on every frame.
+pub struct Trace<W: Write> {
     origin: Instant,
     device: String,
-    cpu: Vec<Value>,
-    gpu: Vec<GpuFrame>,
+    out: W,
+    /// Where `out` goes, for messages.
+    path: PathBuf,
+    /// The first write that failed: reported by `finish`.
+    failed: Option<std::io::Error>,
+    gpu: Vec<GpuPass>,
+    /// Distinct labels of the GPU passes, the newest last.
+    labels: Vec<Value>,
+    /// The smallest shift of the GPU clock that puts no frame's first pass before its
+    /// submission, over the frames so far.
+    offset_ms: Option<f64>,
     frames: u64,
 }
 
-impl Trace {
-    /// An empty trace whose time 0 is now; `device` names the GPU track.
-    pub fn new(device: &str) -> Self {
-        Trace { origin: Instant::now(), device: device.to_string(), cpu: Vec::new(), gpu: Vec::new(), frames: 0 }
+/// A trace streamed to a file.
+pub type FileTrace = Trace<BufWriter<File>>;
+
+impl FileTrace {
+    /// A trace written to `path` (created now, so a bad path fails before a long run);
+    /// time 0 is now and `device` names the GPU track.
+    pub fn create(device: &str, path: &Path) -> Result<Self> {
+        let file = File::create(path).map_err(|error| Error::Io { path: path.into(), error })?;
+        Ok(Trace::new(device, BufWriter::new(file), path))
+    }
+}
+
+impl<W: Write> Trace<W> {
+    /// A trace written to `out`; `path` names it in messages.
+    pub fn new(device: &str, out: W, path: &Path) -> Self {
+        let mut trace = Trace {
+            origin: Instant::now(),
+            device: device.to_string(),
+            out,
+            path: path.into(),
+            failed: None,
+            gpu: Vec::new(),
+            labels: Vec::new(),
+            offset_ms: None,
+            frames: 0,
+        };
+        trace.emit_raw("{\"displayTimeUnit\":\"ms\",\"traceEvents\":[");
+        let meta =
+            |name: &str, tid: u32, args: Value| json!({"name": name, "ph": "M", "pid": PID, "tid": tid, "args": args});
+        let gpu_name = format!("GPU: {}", trace.device);
+        for (i, event) in [
+            meta("process_name", CPU_TID, json!({"name": "softshadow"})),
+            meta("thread_name", CPU_TID, json!({"name": "CPU"})),
+            meta("thread_sort_index", CPU_TID, json!({"sort_index": 0})),
+            meta("thread_name", GPU_TID, json!({"name": gpu_name})),
+            meta("thread_sort_index", GPU_TID, json!({"sort_index": 1})),
+        ]
+        .iter()
+        .enumerate()
+        {
+            trace.emit_raw(if i == 0 { "" } else { "," });
+            trace.emit_raw(&event.to_string());
+        }
+        trace
     }
 
     fn ms(&self, t: Instant) -> f64 {
         t.saturating_duration_since(self.origin).as_secs_f64() * 1e3
     }
 
+    fn emit_raw(&mut self, text: &str) {
+        if self.failed.is_none()
+            && let Err(e) = self.out.write_all(text.as_bytes())
+        {
+            self.failed = Some(e);
+        }
+    }
+
+    fn emit(&mut self, event: Value) {
+        self.emit_raw(",");
+        self.emit_raw(&event.to_string());
+    }
+
     /// A slice on the CPU track from `start` to `end`; slices added within it nest under it.
     pub fn cpu_slice(&mut self, name: &str, start: Instant, end: Instant, args: Value) {
         let (start, end) = (self.ms(start), self.ms(end));
-        self.cpu.push(slice(name, "cpu", CPU_TID, start, end - start, args));
+        self.emit(slice(name, "cpu", CPU_TID, start, end - start, args));
     }
 
     /// Finished frames: a `frame N` slice over each frame's CPU spans, and its GPU passes.
     /// `args` (technique, scene, setting…) are attached to every slice.
     pub fn add_frames(&mut self, frames: &[FrameTimings], args: &Value) {
+        if self.labels.last() != Some(args) {
+            self.labels.push(args.clone());
+        }
+        let label = self.labels.len() - 1;
         for f in frames {
             let frame = self.frames;
             self.frames += 1;
@@ -64,64 +137,50 @@ impl Trace {
             if let (Some(first), Some(last)) = (f.cpu.first(), f.cpu.last()) {
                 let start = self.ms(first.start);
                 let end = self.ms(last.start) + last.ms;
-                self.cpu.push(slice(&format!("frame {frame}"), "cpu", CPU_TID, start, end - start, frame_args.clone()));
+                self.emit(slice(&format!("frame {frame}"), "cpu", CPU_TID, start, end - start, frame_args.clone()));
                 for s in &f.cpu {
-                    self.cpu.push(slice(s.name, "cpu", CPU_TID, self.ms(s.start), s.ms, frame_args.clone()));
+                    let event = slice(s.name, "cpu", CPU_TID, self.ms(s.start), s.ms, frame_args.clone());
+                    self.emit(event);
                 }
             }
-            if let Some(submitted) = f.submitted() {
-                self.gpu.push(GpuFrame {
-                    frame,
-                    submitted_ms: self.ms(submitted),
-                    passes: f.passes.iter().map(|p| (p.name, p.begin_ms, p.ms)).collect(),
-                    args: frame_args,
-                });
+            let first_begin = f.passes.iter().map(|p| p.begin_ms).reduce(f64::min);
+            if let (Some(submitted), Some(begin)) = (f.submitted(), first_begin) {
+                let shift = self.ms(submitted) - begin;
+                self.offset_ms = Some(self.offset_ms.map_or(shift, |o| o.max(shift)));
+                let passes =
+                    f.passes.iter().map(|p| GpuPass { frame, label, name: p.name, begin_ms: p.begin_ms, ms: p.ms });
+                self.gpu.extend(passes);
             }
         }
     }
 
-    /// The trace as a Chrome trace JSON object.
-    pub fn to_json(&self) -> Value {
-        let offset = self
-            .gpu
-            .iter()
-            .filter_map(|f| f.passes.iter().map(|p| p.1).reduce(f64::min).map(|begin| f.submitted_ms - begin))
-            .reduce(f64::max)
-            .unwrap_or(0.0);
-        let mut passes: Vec<(f64, f64, &str, &GpuFrame)> = self
-            .gpu
-            .iter()
-            .flat_map(|f| f.passes.iter().map(move |&(name, begin, ms)| (begin + offset, ms, name, f)))
-            .collect();
-        passes.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut gpu = Vec::with_capacity(passes.len());
+    /// Writes the GPU track, placed on the host's clock and trimmed so that no two slices
+    /// overlap, closes the trace and returns the output.
+    pub fn finish(mut self) -> Result<W> {
+        let offset = self.offset_ms.unwrap_or(0.0);
+        let mut passes = std::mem::take(&mut self.gpu);
+        passes.sort_by(|a, b| a.begin_ms.total_cmp(&b.begin_ms));
         let mut free_from = f64::NEG_INFINITY;
-        for (start, ms, name, f) in passes {
+        for p in passes {
+            let start = p.begin_ms + offset;
             let begin = start.max(free_from);
-            let end = (start + ms).max(begin);
+            let end = (start + p.ms).max(begin);
             free_from = end;
-            let mut args = f.args.clone();
-            args["gpu_ms"] = json!(ms);
-            args["frame"] = json!(f.frame);
-            gpu.push(slice(name, "gpu", GPU_TID, begin, end - begin, args));
+            let mut args = self.labels[p.label].clone();
+            args["gpu_ms"] = json!(p.ms);
+            args["frame"] = json!(p.frame);
+            self.emit(slice(p.name, "gpu", GPU_TID, begin, end - begin, args));
         }
-        let meta =
-            |name: &str, tid: u32, args: Value| json!({"name": name, "ph": "M", "pid": PID, "tid": tid, "args": args});
-        let mut events = vec![
-            meta("process_name", CPU_TID, json!({"name": "softshadow"})),
-            meta("thread_name", CPU_TID, json!({"name": "CPU"})),
-            meta("thread_sort_index", CPU_TID, json!({"sort_index": 0})),
-            meta("thread_name", GPU_TID, json!({"name": format!("GPU: {}", self.device)})),
-            meta("thread_sort_index", GPU_TID, json!({"sort_index": 1})),
-        ];
-        events.extend(self.cpu.iter().cloned());
-        events.extend(gpu);
-        json!({"traceEvents": events, "displayTimeUnit": "ms"})
-    }
-
-    pub fn write(&self, path: &Path) -> Result<()> {
-        let text = self.to_json().to_string();
-        std::fs::write(path, text).map_err(|error| Error::Io { path: path.into(), error })
+        self.emit_raw("]}");
+        if self.failed.is_none()
+            && let Err(e) = self.out.flush()
+        {
+            self.failed = Some(e);
+        }
+        match self.failed.take() {
+            Some(error) => Err(Error::Io { path: self.path.clone(), error }),
+            None => Ok(self.out),
+        }
     }
 }
 
@@ -157,12 +216,12 @@ mod tests {
 
     #[test]
     fn gpu_slices_follow_submission_and_never_overlap() {
-        let mut trace = Trace::new("test device");
+        let mut trace = Trace::new("test device", Vec::new(), "memory".as_ref());
         let t0 = trace.origin + Duration::from_millis(10);
         // GPU clock origin far from the host's: 5000 ms.
         let frames = [frame(t0, 5000.0), frame(t0 + Duration::from_millis(3), 5005.0)];
         trace.add_frames(&frames, &json!({"technique": "pcf"}));
-        let json = trace.to_json();
+        let json: serde_json::Value = serde_json::from_slice(&trace.finish().unwrap()).unwrap();
         let events = json["traceEvents"].as_array().unwrap();
         let slices = |tid: u64| -> Vec<(f64, f64, String)> {
             events

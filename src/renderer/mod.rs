@@ -80,6 +80,9 @@ pub struct CpuSpan {
     pub ms: f64,
 }
 
+/// Finished frames whose timings an engine keeps until they are taken: ten seconds at 60 Hz.
+pub const DEFAULT_TIMING_HISTORY: usize = 600;
+
 /// The CPU span spent waiting for a frame slot's previous frame (not recording work).
 pub const WAIT_FOR_SLOT: &str = "wait for slot";
 /// The CPU span that ends with the frame's submission.
@@ -183,7 +186,9 @@ pub struct Engine {
     visibility_format: vk::Format,
     ground_mesh: Arc<Mesh>,
     frame_number: u64,
-    timings: Vec<FrameTimings>,
+    /// Finished frames' timings not yet taken, at most `timing_history` of them.
+    timings: std::collections::VecDeque<FrameTimings>,
+    timing_history: usize,
     /// CPU spans of submitted frames whose GPU times have not come back yet, oldest first.
     cpu_spans: std::collections::VecDeque<Vec<CpuSpan>>,
     // Declared last: dropped after everything above is destroyed in `Drop`.
@@ -207,7 +212,8 @@ impl Engine {
             visibility_format: VISIBILITY_FORMAT,
             ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
             frame_number: 0,
-            timings: Vec::new(),
+            timings: Default::default(),
+            timing_history: DEFAULT_TIMING_HISTORY,
             cpu_spans: Default::default(),
             ctx,
         };
@@ -255,9 +261,19 @@ impl Engine {
         Ok(self.frame(scene, settings, true)?.expect("capture requested"))
     }
 
-    /// Timings of every frame finished since the last call, oldest first.
+    /// Timings of the frames finished since the last call, oldest first: the newest
+    /// [`Engine::set_timing_history`] of them, so a loop that never asks does not grow.
     pub fn take_timings(&mut self) -> Vec<FrameTimings> {
-        std::mem::take(&mut self.timings)
+        std::mem::take(&mut self.timings).into()
+    }
+
+    /// How many finished frames' timings are kept for [`Engine::take_timings`] (older ones
+    /// are dropped); [`DEFAULT_TIMING_HISTORY`] unless set. At least 1.
+    pub fn set_timing_history(&mut self, frames: usize) {
+        self.timing_history = frames.max(1);
+        while self.timings.len() > self.timing_history {
+            self.timings.pop_front();
+        }
     }
 
     /// Waits for every frame in flight, so that their timings are available.
@@ -279,7 +295,10 @@ impl Engine {
     fn push_timings(&mut self, done: impl IntoIterator<Item = Vec<PassTime>>) {
         for passes in done {
             let cpu = self.cpu_spans.pop_front().unwrap_or_default();
-            self.timings.push(FrameTimings { passes, cpu });
+            if self.timings.len() == self.timing_history {
+                self.timings.pop_front();
+            }
+            self.timings.push_back(FrameTimings { passes, cpu });
         }
     }
 

@@ -91,9 +91,11 @@ impl Mesh {
         if let Some(line) = overlong_line(&bytes, MAX_OBJ_LINE) {
             return Err(Error::scene(path, format!("line {line} is longer than {MAX_OBJ_LINE} bytes")));
         }
+        let text = String::from_utf8_lossy(&bytes);
+        let shape = obj_shape(&text).map_err(|what| Error::scene(path, what))?;
         let options = tobj::LoadOptions { triangulate: true, single_index: false, ..Default::default() };
         let no_materials = |_: &Path| Err(tobj::LoadError::OpenFileFailed);
-        let (models, _materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, no_materials)
+        let (models, _materials) = tobj::load_obj_buf(&mut shape.as_bytes(), &options, no_materials)
             .map_err(|e| Error::scene(path, format!("not a valid OBJ file: {e}")))?;
         let mut positions = Vec::new();
         let mut triangles = Vec::new();
@@ -195,6 +197,50 @@ impl UnionFind {
             self.parent[a.max(b)] = a.min(b);
         }
     }
+}
+
+/// The shape of an OBJ file, checked line by line: vertices and the faces, lines and points
+/// over them, each index in range, texture and normal references dropped (only the shape casts
+/// shadows). What tobj then parses cannot overflow its index arithmetic, and a bad element is
+/// reported at its line.
+fn obj_shape(text: &str) -> std::result::Result<String, String> {
+    let mut out = String::with_capacity(text.len());
+    let mut vertices: i64 = 0;
+    for (n, line) in text.lines().enumerate() {
+        let at = |what: String| format!("line {}: {what}", n + 1);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let xyz: Vec<&str> = words.take(3).collect();
+                if xyz.len() < 3 || xyz.iter().any(|w| w.parse::<f32>().is_err()) {
+                    return Err(at(format!("a vertex needs three numbers, got `{}`", line.trim())));
+                }
+                vertices += 1;
+                out.push_str(&format!("v {}\n", xyz.join(" ")));
+            }
+            Some(element @ ("f" | "l" | "p")) => {
+                out.push_str(element);
+                for word in words {
+                    let position = word.split('/').next().unwrap_or_default();
+                    // 1-based, or negative: counted back from the last vertex so far.
+                    let index = position
+                        .parse::<i64>()
+                        .ok()
+                        .filter(|i| (1..=vertices).contains(i) || (-vertices..0).contains(i));
+                    let Some(index) = index else {
+                        return Err(at(format!(
+                            "`{word}` is not a vertex index in 1..={vertices} or -{vertices}..=-1"
+                        )));
+                    };
+                    let absolute = if index < 0 { vertices + 1 + index } else { index };
+                    out.push_str(&format!(" {absolute}"));
+                }
+                out.push('\n');
+            }
+            _ => {}
+        }
+    }
+    Ok(out)
 }
 
 /// Merges bit-identical positions so faces share edges (OBJ files often repeat seam vertices).
