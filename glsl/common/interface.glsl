@@ -39,7 +39,8 @@ struct LightView {
 struct LightSample {
     LightView view;
     vec4 position;   // xyz; w = 1 with a shadow map, 0 when nothing in view can block it
-    vec4 pad[4];
+    vec4 normal;     // xyz the sphere's outward normal there (0: a point light); w its weight
+    vec4 pad[3];
 };
 
 // The plateau texture's frame (Haines): the receiver plane, in-plane axes, the window.

@@ -1,7 +1,8 @@
 #version 460
 // Heckbert & Herf's accumulation, one batch: for each light sample q of the batch, a hard
 // shadow test against its tile of the atlas, weighted by the solid angle the light's surface
-// around q stands for as seen from p: max(0, cos theta_q) / |p - q|^2. Sums add across batches.
+// around q stands for as seen from p, max(0, cos theta_q) / |p - q|^2, over the density q was
+// drawn with (its weight). Sums add across batches.
 #include "interface.glsl"
 #include "camera.glsl"
 #include "shadow.glsl"
@@ -26,11 +27,12 @@ void main() {
     float d2_center = dot(s.p - center, s.p - center);
     for (int i = 0; i < samples.length(); i++) {
         vec3 q = samples[i].position.xyz;
-        float weight = 1.0; // a point light: every sample is the centre
-        if (frame.light.w > 0.0) {
+        vec4 normal = samples[i].normal; // from the CPU: q - center may round to nothing here
+        float weight = 1.0; // a point light: its one sample is the centre
+        if (normal.xyz != vec3(0.0)) {
             vec3 to_p = s.p - q;
             float d2 = dot(to_p, to_p);
-            weight = max(dot(normalize(q - center), to_p) * inversesqrt(d2), 0.0) * d2_center / d2;
+            weight = max(dot(normal.xyz, to_p) * inversesqrt(d2), 0.0) * (d2_center / d2) * normal.w;
         }
         if (weight == 0.0) {
             continue;

@@ -48,7 +48,10 @@ pub struct LightSample {
     pub view: LightView,
     /// xyz the point; w 1 when it has a shadow map, 0 when nothing in view can block it.
     pub position: Vec4,
-    pub pad: [Vec4; 4],
+    /// xyz the light sphere's outward normal at the point (0 for a point light); w its
+    /// importance weight (`geometry::LightPoint`).
+    pub normal: Vec4,
+    pub pad: [Vec4; 3],
 }
 
 /// The plateau texture's frame: the receiver plane and the window of it the texture covers.

@@ -58,9 +58,14 @@ impl CameraProjection {
         let proj = match projection {
             Projection::Perspective { fov_y_deg } => {
                 let far = if dmax > 0.0 { dmax * 1.01 } else { 1.0 };
-                // Reverse Z keeps precision with a near plane this close.
-                let near = (dmin * 0.99).max(far * 1e-5);
-                reverse_z_perspective(((fov_y_deg as f64).to_radians() * 0.5).tan(), aspect, near, far)
+                let tan_half = ((fov_y_deg as f64).to_radians() * 0.5).tan();
+                // Nothing in view is nearer than the scene's box times the cosine of the view's
+                // half diagonal: a fixed fraction of `far` would cut a caster 4 m away out of a
+                // view over a ground 1e7 m wide. Reverse Z keeps its precision down to 1e-9 of it.
+                let gap = (scene.min.as_dvec3() - pos).max(pos - scene.max.as_dvec3()).max(glam::DVec3::ZERO);
+                let cos_diagonal = 1.0 / (1.0 + tan_half * tan_half * (1.0 + aspect * aspect)).sqrt();
+                let near = (dmin * 0.99).max(gap.length() * cos_diagonal * 0.99).max(far * 1e-9);
+                reverse_z_perspective(tan_half, aspect, near, far)
             }
             Projection::Orthographic { half_height } => {
                 let pad = ((dmax - dmin) * 0.01).max(1e-6 * dmax.abs().max(1.0));

@@ -15,8 +15,8 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::frame::Surfaces;
-use crate::geometry::{Aabb, CameraProjection};
-use crate::scene::{Light, Scene};
+use crate::geometry::{CameraProjection, point_like};
+use crate::scene::{Ground, Light, Scene};
 
 /// A visibility image and the surfaces it was estimated at.
 #[derive(Clone, Debug)]
@@ -28,10 +28,13 @@ pub struct TracedImage {
 
 /// World-space triangles of one scene, with acceleration structures.
 pub struct TraceScene {
-    /// Every object and the ground: what camera rays hit.
-    everything: TriMesh,
-    /// Object index of each triangle of `everything` (the ground is the last object).
+    /// Every object: what camera rays hit, besides the ground.
+    everything: Option<TriMesh>,
+    /// Object index of each triangle of `everything`.
     object_of: Vec<u32>,
+    /// The ground as the exact plane it is (object index `receives.len() - 1`): two triangles
+    /// a million times wider than the casters would place every hit on them metres off.
+    ground: Option<Ground>,
     receives: Vec<bool>,
     /// The casters' triangles: what shadow rays test.
     casters: Option<TriMesh>,
@@ -41,10 +44,11 @@ pub struct TraceScene {
     spheres: Vec<Option<(Vec3, f32)>>,
     /// Which objects cast, by object index.
     casts: Vec<bool>,
-    /// Offset of shadow-ray origins off their surface: relative to the scene's size, so it
-    /// holds at any scale.
-    epsilon: f32,
 }
+
+/// Offset of a shadow ray's origin off its surface, relative to the coordinates that place the
+/// hit (f32 resolves 1.2e-7 of them): local, so a wide ground or far objects do not lift it.
+const LIFT: f32 = 1e-5;
 
 struct Triangles {
     positions: Vec<Vec3>,
@@ -80,11 +84,9 @@ impl TraceScene {
         let mut receives = Vec::new();
         let mut spheres = Vec::new();
         let mut casts = Vec::new();
-        let mut bounds = Aabb::EMPTY;
         for (i, o) in scene.objects.iter().enumerate() {
             let model = o.transform.matrix();
             let world: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
-            bounds = bounds.union(&Aabb::from_points(world.iter().copied()));
             all.push(i as u32, world.iter().copied(), &o.mesh.triangles);
             if o.casts {
                 casters.push(i as u32, world, &o.mesh.triangles);
@@ -93,28 +95,24 @@ impl TraceScene {
             casts.push(o.casts);
             spheres.push(o.sphere().filter(|_| o.casts));
         }
-        if let Some(g) = &scene.ground {
-            let (h, s) = (g.height, g.half_size);
-            let corners = [Vec3::new(-s, h, -s), Vec3::new(s, h, -s), Vec3::new(s, h, s), Vec3::new(-s, h, s)];
-            bounds = bounds.union(&Aabb::from_points(corners));
-            all.push(receives.len() as u32, corners, &[[0, 2, 1], [0, 3, 2]]);
+        if scene.ground.is_some() {
             receives.push(true);
             casts.push(false);
         }
-        let Some((everything, object_of)) = all.mesh("scene")? else {
+        let (everything, object_of) = all.mesh("scene")?.unzip();
+        if everything.is_none() && scene.ground.is_none() {
             return Err(Error::Invalid("ray tracer: the scene has nothing to trace".into()));
-        };
+        }
         let (casters, caster_object_of) = casters.mesh("caster")?.unzip();
-        let epsilon = 1e-5 * (bounds.max - bounds.min).length();
         Ok(TraceScene {
             everything,
-            object_of,
+            object_of: object_of.unwrap_or_default(),
+            ground: scene.ground,
             receives,
             casters,
             caster_object_of: caster_object_of.unwrap_or_default(),
             spheres,
             casts,
-            epsilon,
         })
     }
 
@@ -148,28 +146,46 @@ impl TraceScene {
                     let index = y * width as usize + x;
                     let uv = Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / height as f32);
                     let (origin, dir) = camera.ray(uv);
-                    let ray = Ray::new(origin, dir);
-                    let Some((tri, t)) = CompositeShapeRef(&self.everything).cast_local_ray(&ray, f32::MAX, false)
-                    else {
-                        continue;
-                    };
-                    let p = origin + dir * t;
+                    let Some(hit) = self.camera_hit(origin, dir) else { continue };
+                    let p = origin + dir * hit.t;
                     d_row[x] = (p - camera.position).dot(camera.forward);
-                    let facet = self.everything.triangle(tri).normal().unwrap_or(-dir);
-                    let facing = if facet.dot(dir) > 0.0 { -facet } else { facet };
+                    let facing = if hit.facet.dot(dir) > 0.0 { -hit.facet } else { hit.facet };
                     n_row[x] = facing;
-                    if !self.receives[self.object_of[tri as usize] as usize] {
+                    if !self.receives[hit.object] {
                         continue;
                     }
                     r_row[x] = true;
-                    let caster = self.casts[self.object_of[tri as usize] as usize];
+                    let caster = self.casts[hit.object];
                     c_row[x] = caster;
-                    let surface = Surface { point: p + facing * self.epsilon, solid_side: caster.then_some(facing) };
+                    let lift = LIFT * (p.abs().max_element() + hit.t + hit.extent).max(f32::MIN_POSITIVE);
+                    let surface = Surface { point: p + facing * lift, solid_side: caster.then_some(facing) };
                     v_row[x] = shade(surface, index);
                 }
                 progress();
             });
         TracedImage { visibility, surfaces: Surfaces { depth, normal, receives, casts: cast } }
+    }
+
+    /// The nearest surface along the camera ray from `origin` along unit `dir`.
+    fn camera_hit(&self, origin: Vec3, dir: Vec3) -> Option<Hit> {
+        let ray = Ray::new(origin, dir);
+        let object = self.everything.as_ref().and_then(|m| {
+            let (tri, t) = CompositeShapeRef(m).cast_local_ray(&ray, f32::MAX, false)?;
+            let triangle = m.triangle(tri);
+            let extent = (triangle.b - triangle.a).abs().max((triangle.c - triangle.a).abs()).max_element();
+            let facet = triangle.normal().unwrap_or(-dir);
+            Some(Hit { t, facet, object: self.object_of[tri as usize] as usize, extent })
+        });
+        let ground = self.ground.and_then(|g| {
+            let t = (g.height - origin.y) / dir.y;
+            let p = origin + dir * t;
+            let inside = t > 0.0 && p.x.abs() <= g.half_size && p.z.abs() <= g.half_size;
+            inside.then(|| Hit { t, facet: Vec3::Y, object: self.receives.len() - 1, extent: 0.0 })
+        });
+        match (object, ground) {
+            (Some(o), Some(g)) => Some(if g.t < o.t { g } else { o }),
+            (o, g) => o.or(g),
+        }
     }
 
     /// Whether a caster crosses the segment from `origin` along unit `dir` for `length`.
@@ -191,7 +207,7 @@ impl TraceScene {
         let p = s.point;
         let to_center = light.position - p;
         let d = to_center.length();
-        if light.radius == 0.0 {
+        if point_like(light.position, light.radius) {
             return if self.shadow_ray_blocked(s, to_center / d, d) { 0.0 } else { 1.0 };
         }
         if d <= light.radius {
@@ -199,25 +215,40 @@ impl TraceScene {
         }
         let axis = to_center / d;
         let (u, v) = axis.any_orthonormal_pair();
-        let cos_max = (1.0 - (light.radius / d).powi(2)).max(0.0).sqrt();
-        let c2 = d * d - light.radius * light.radius;
+        // 1 − cos θ_max from sin θ_max = r / d, without the cancellation of 1 − cos: exact for
+        // lights a million times smaller than their distance and for those nearly as large.
+        let (r, d64) = (light.radius as f64, d as f64);
+        let sin2 = (r / d64).powi(2);
+        let one_minus_cos_max = (sin2 / (1.0 + (1.0 - sin2).sqrt())) as f32;
+        // Distance from p to the sphere's near side along `dir` (for the ray length): the near
+        // root of t² − 2bt + (d − r)(d + r) = 0, as (d² − r²) / (b + √(b² − d² + r²)).
+        let c2 = ((d64 - r) * (d64 + r)) as f32;
         let mut rng = Rng::new(seed);
         let phi0 = rng.next() * std::f32::consts::TAU;
         let golden_angle = std::f32::consts::PI * (3.0 - 5.0f32.sqrt());
         let lit = (0..samples)
             .filter(|&i| {
-                let cos = 1.0 - (1.0 - cos_max) * (i as f32 + rng.next()) / samples as f32;
-                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let one_minus_cos = one_minus_cos_max * (i as f32 + rng.next()) / samples as f32;
+                let cos = 1.0 - one_minus_cos;
+                let sin = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
                 let phi = phi0 + golden_angle * i as f32;
                 let dir = cos * axis + sin * (phi.cos() * u + phi.sin() * v);
-                // Distance to the near side of the sphere along `dir`.
                 let b = dir.dot(to_center);
-                let to_light = b - (b * b - c2).max(0.0).sqrt();
+                let to_light = c2 / (b + (b * b - c2).max(0.0).sqrt());
                 !self.shadow_ray_blocked(s, dir, to_light)
             })
             .count();
         lit as f32 / samples as f32
     }
+}
+
+/// A camera ray's hit: distance, facet normal, object index, and the size of what was hit
+/// (a triangle's coordinates, which limit how exactly its hit is placed).
+struct Hit {
+    t: f32,
+    facet: Vec3,
+    object: usize,
+    extent: f32,
 }
 
 /// A point where V is estimated.

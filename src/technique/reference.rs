@@ -3,11 +3,13 @@
 //! averaged.
 //!
 //! V is defined (DESIGN.md §3) as the unblocked fraction of the solid angle the spherical light
-//! subtends at p. The points are spread uniformly in area over the cap of the sphere that any
-//! receiver in view can see ([`visible_cap`]); each one stands for a patch of the surface whose
-//! solid angle at p is max(0, cos θ_q)·dA / |p − q|², so the accumulation weights each sample by
-//! that per pixel and divides by the sum of the weights. Samples facing away from p weigh 0,
-//! which is what makes the estimate right far from the light's axis too.
+//! subtends at p. The points ([`light_points`]) are spread half uniformly in area over the cap
+//! of the sphere that any receiver in view can see, half uniformly in the solid angle at the
+//! receivers' centre (which a huge light near them needs); each one stands for a patch of the
+//! surface whose solid angle at p is max(0, cos θ_q)·dA / |p − q|², over the density it was
+//! drawn with, so the accumulation weights each sample by that per pixel and divides by the
+//! sum of the weights. Samples facing away from p weigh 0, which is what makes the estimate
+//! right far from the light's axis too. A light too small to place points on is a point.
 //!
 //! Batching: the shadow maps of up to 16 samples are rendered into the tiles of one atlas, then
 //! one full-screen pass adds all of their contributions at once (additive blending into an
@@ -26,7 +28,7 @@ use super::{Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::{LightSample, LightView};
-use crate::geometry::{cap_points, fit_spot_frustum, visible_cap};
+use crate::geometry::{fit_spot_frustum, light_points};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, Milestones, PerFrame,
     Pipeline, RenderPass, Target, TargetDesc, draw_fullscreen, ensure, shaders, transition,
@@ -101,17 +103,12 @@ impl Reference {
     fn light_samples(frame: &FrameInputs<'_>, n: usize, size: u32) -> Vec<LightSample> {
         let light = &frame.scene.light;
         let casters = caster_bounds(frame);
-        // A point light has one point to sample.
-        let points = if light.radius > 0.0 {
-            let cap = visible_cap(light.position, light.radius, frame.receivers_in_view);
-            cap_points(light.position, light.radius, cap, n)
-        } else {
-            vec![light.position]
-        };
+        let points = light_points(light.position, light.radius, frame.receivers_in_view, n);
         let mut clipped = Vec::new();
         let samples = points
             .into_iter()
-            .map(|q| {
+            .map(|point| {
+                let q = point.position;
                 let fit = fit_spot_frustum(q, light.target, &casters, frame.receivers_in_view);
                 clipped.extend(fit.clipped);
                 let frustum = fit.frustum;
@@ -123,7 +120,12 @@ impl Reference {
                     kernel: Vec4::ZERO,
                 });
                 let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
-                LightSample { view, position: q.extend(has_map), pad: [Vec4::ZERO; 4] }
+                LightSample {
+                    view,
+                    position: q.extend(has_map),
+                    normal: point.normal.extend(point.weight),
+                    pad: [Vec4::ZERO; 3],
+                }
             })
             .collect();
         clipped.sort_unstable();

@@ -1,0 +1,310 @@
+//! Issue 19, class 2: the ground truths stay true, and every technique stays sound, across the
+//! range of numbers a scene file accepts. Three reported failures as regression tests, then a
+//! property test over scene scale, light radius, light distance and object spread that
+//! iterates the registry.
+//!
+//! The property test runs 6 cases by default (about a minute on two cores); a longer run:
+//! `PROPTEST_CASES=64 cargo test --release --test truths`.
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{engine, finish, render_with};
+use glam::Vec3;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestRng, TestRunner};
+use softshadow::measure::Metrics;
+use softshadow::scene::{Camera, Ground, Light, Object, Projection, RenderSettings, Scene, primitives};
+use softshadow::technique::registry::{Kind, Runs, ground_truth};
+use softshadow::technique::{Params, TECHNIQUES};
+use softshadow::{Capture, Engine, FrameSettings};
+
+/// Image side of every render here: small, the checks are about gross failures.
+const SIZE: u32 = 40;
+
+/// RMSE the two ground truths may differ by, wherever both accept a scene, off hard edges
+/// ([`rmse_off_hard_edges`]).
+const TRUTHS_AGREE: f64 = 0.01;
+
+/// RMSE of `c` against `truth` over the receiver pixels both see alike (depths within 0.1 %),
+/// leaving out those at a hard edge of the truth (V spans more than ½ over their 3×3
+/// neighbours): there a pixel's one camera ray falls on either side, for a shadow map and a
+/// ray tracer alike (a point light: 5 pixels of 1600 off by 0.8, RMSE 0.034).
+fn rmse_off_hard_edges(c: &Capture, truth: &Capture) -> f64 {
+    let (w, h) = (SIZE as i64, SIZE as i64);
+    let v = |x: i64, y: i64| truth.visibility_at(x.clamp(0, w - 1) as u32, y.clamp(0, h - 1) as u32);
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let (a, b) = (&c.surfaces, &truth.surfaces);
+            let alike = (a.depth[i] - b.depth[i]).abs() <= 1e-3 * a.depth[i].max(b.depth[i]);
+            if !(a.receives[i] && b.receives[i] && alike) {
+                continue;
+            }
+            let near = (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))).map(|(dx, dy)| v(x + dx, y + dy));
+            let (lo, hi) = near.fold((1.0f32, 0.0f32), |(lo, hi), v| (lo.min(v), hi.max(v)));
+            if hi - lo <= 0.5 {
+                sum += ((c.visibility_at(x as u32, y as u32) - v(x, y)) as f64).powi(2);
+                n += 1;
+            }
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// A cube of side `s` whose bottom is `s / 2` above the ground, seen in perspective from above
+/// and behind its shadow; a light of `radius` whose nearest point is `gap` from the cube's
+/// centre, towards `elevation_deg` above +x; a ball of radius `s / 2` `spread` away along +z;
+/// the ground wide enough for both.
+#[derive(Clone, Copy, Debug)]
+struct Case {
+    s: f32,
+    radius: f32,
+    gap: f32,
+    elevation_deg: f32,
+    spread: f32,
+}
+
+impl Case {
+    fn centre(&self) -> Vec3 {
+        Vec3::new(0.0, self.s, 0.0)
+    }
+
+    /// Unit vector from the cube's centre to the light's, raised where needed to keep the light
+    /// above the ground.
+    fn towards_light(&self) -> Vec3 {
+        let reach = self.gap + self.radius;
+        // The light's bottom at least s/4 above the ground: sin e ≥ (r − y_c + s/4) / reach.
+        let lowest = ((self.radius - 0.75 * self.s) / reach).clamp(-1.0, 1.0).asin();
+        let e = self.elevation_deg.to_radians().max(lowest).min(std::f32::consts::FRAC_PI_2);
+        Vec3::new(e.cos(), e.sin(), 0.0)
+    }
+
+    /// Where the light's centre casts the cube's centre on the ground.
+    fn shadow(&self) -> Vec3 {
+        let (c, l) = (self.centre(), self.towards_light());
+        c - l * (c.y / l.y)
+    }
+
+    fn scene(&self) -> Scene {
+        let s = self.s;
+        let mut cube = Object::new("cube", Arc::new(primitives::cuboid(Vec3::splat(s)).unwrap()));
+        cube.transform.position = self.centre();
+        let mut ball = Object::new("ball", Arc::new(primitives::sphere(0.5 * s).unwrap()));
+        ball.transform.position = Vec3::new(0.0, s, self.spread + 2.0 * s);
+        let shadow = self.shadow();
+        let half = (20.0 * s).max(2.0 * (self.spread + 3.0 * s)).max(shadow.x.abs() * 2.0);
+        let scene = Scene {
+            camera: Camera {
+                position: shadow + Vec3::new(-2.0, 6.0, 6.0) * s,
+                target: shadow,
+                up: Vec3::Y,
+                projection: Projection::Perspective { fov_y_deg: 40.0 },
+            },
+            light: Light {
+                position: self.centre() + self.towards_light() * (self.gap + self.radius),
+                radius: self.radius,
+                target: None,
+            },
+            ground: Some(Ground { height: 0.0, half_size: half }),
+            objects: vec![cube, ball],
+            render: RenderSettings { width: SIZE, height: SIZE, ..RenderSettings::default() },
+        };
+        scene.validate().expect("the cases are valid scenes");
+        scene
+    }
+
+    /// Whether the shadow's centre must be an umbra: the light subtends less than half the
+    /// angle the cube does from there.
+    fn has_umbra(&self) -> bool {
+        let from_shadow = self.centre() - self.shadow();
+        let cube = (0.5 * self.s / from_shadow.length()).atan();
+        let light = (self.radius / (self.gap + self.radius + from_shadow.length())).asin();
+        light < 0.5 * cube
+    }
+}
+
+fn settings(technique: &'static softshadow::technique::TechniqueInfo, knobs: &[(&str, &str)]) -> FrameSettings {
+    let mut params = Params::defaults(technique);
+    params.apply(knobs.iter().copied()).expect("valid knobs");
+    FrameSettings { width: SIZE, height: SIZE, params }
+}
+
+/// Fraction of the receiver pixels with V < ½.
+fn shadowed(c: &Capture) -> f64 {
+    let dark = c.visibility.iter().zip(&c.surfaces.receives).filter(|(v, r)| **r && **v < 32768).count();
+    dark as f64 / c.surfaces.receives.iter().filter(|r| **r).count().max(1) as f64
+}
+
+fn wall_on(half_size: f32) -> Scene {
+    let mut s = common::wall(1.0, 0.25);
+    s.ground.as_mut().unwrap().half_size = half_size;
+    s.camera.position = Vec3::new(-1.3, 4.0, 4.0);
+    s.camera.target = Vec3::new(-1.3, 0.0, 0.0);
+    s.camera.up = Vec3::Y;
+    s.camera.projection = Projection::Perspective { fov_y_deg: 40.0 };
+    s
+}
+
+/// Issue 19: with a ground of half size 1e5 the tracer lost 97 % of the shadow (its shadow-ray
+/// offset was relative to the whole scene: 2.8 m), and at 1e7 the near plane (1e-5 of the far
+/// one) cut the objects out of the frame. The shadow must cover what it covers on a 10 m ground.
+#[test]
+fn the_tracer_keeps_its_shadows_on_huge_grounds() {
+    let mut e = engine();
+    let traced = |e: &mut Engine, g: f32| render_with(e, &wall_on(g), "raytrace", &[("samples", "64")], 64);
+    let base = shadowed(&traced(&mut e, 10.0));
+    assert!(base > 0.1, "the wall's shadow is in view: {base}");
+    for g in [1e3, 1e4, 1e5, 1e7, 1e9] {
+        let c = traced(&mut e, g);
+        let lost = 1.0 - shadowed(&c) / base;
+        assert!(lost.abs() < 0.03, "ground half size {g:e}: {:.1} % of the shadow lost", 100.0 * lost);
+    }
+    finish(e);
+}
+
+/// Issue 19: below a radius of about 1e-7 every sample of `reference` rounded to the light's
+/// centre, which made its weights NaN and V 1 everywhere; a subnormal radius gave a different
+/// image each run. A light too small for f32 to place points on is a point light, in both
+/// truths, and the same every run.
+#[test]
+fn lights_too_small_to_sample_are_point_lights() {
+    let mut e = engine();
+    let mut s = common::wall(1.0, 0.0);
+    s.light.position = Vec3::new(3.1, 3.3, 0.7);
+    let knobs = [("samples", "16"), ("shadow_map_size", "256")];
+    let point = render_with(&mut e, &s, "reference", &knobs, 64);
+    let traced_point = render_with(&mut e, &s, "raytrace", &[("samples", "16")], 64);
+    assert!(shadowed(&point) > 0.1);
+    for radius in [1e-8, 1e-30, f32::MIN_POSITIVE / 8.0] {
+        s.light.radius = radius;
+        for (technique, truth) in [("reference", &point), ("raytrace", &traced_point)] {
+            let knobs: &[_] = if technique == "reference" { &knobs } else { &[("samples", "16")] };
+            let a = render_with(&mut e, &s, technique, knobs, 64);
+            let b = render_with(&mut e, &s, technique, knobs, 64);
+            assert!(a.visibility == b.visibility, "{technique}, radius {radius:e}: two runs differ");
+            let m = Metrics::between(&a, truth).unwrap();
+            assert!(m.max_abs < 0.01, "{technique}, radius {radius:e}: {m:?} against the point light");
+        }
+    }
+    finish(e);
+}
+
+/// Issue 19: a light of radius 1e6 whose bottom is 10 m above the ground. `reference` spread
+/// its samples uniformly over the 4.5 km cap the ground sees, nearly none where the solid
+/// angle is (MAE 0.10 against the tracer); plateaus drew their hard umbra under a light that
+/// casts none, and streaks from cones capped at 85° (MAE 0.87).
+#[test]
+fn a_huge_light_just_above_the_ground() {
+    let mut e = engine();
+    let mut s = common::wall(1.0, 0.25);
+    s.light.radius = 1e6;
+    s.light.position = Vec3::new(3.0, 1e6 + 10.0, 0.0);
+    let truth = render_with(&mut e, &s, "raytrace", &[("samples", "1024")], 64);
+    let reference = render_with(&mut e, &s, "reference", &[("samples", "256"), ("shadow_map_size", "512")], 64);
+    let m = Metrics::between(&reference, &truth).unwrap();
+    assert!(m.rmse < TRUTHS_AGREE, "reference against the tracer: {m:?}");
+    let mut plateau = settings(softshadow::technique::find("plateau").unwrap(), &[]);
+    plateau.width = 64;
+    plateau.height = 64;
+    match e.render_and_capture(&s, &plateau) {
+        Ok(c) => {
+            let m = Metrics::between(&c, &truth).unwrap();
+            assert!(m.mae < 0.1, "plateau against the tracer: {m:?}");
+        }
+        Err(error) => assert!(error.to_string().contains("light"), "refused without saying why: {error}"),
+    }
+    finish(e);
+}
+
+/// Log-uniform in [10^lo, 10^hi].
+fn log_uniform(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
+    (lo..hi).prop_map(|x| 10f32.powf(x))
+}
+
+fn cases() -> impl Strategy<Value = Case> {
+    let radius = prop_oneof![1 => Just(0.0f32), 1 => Just(1e-40f32), 4 => log_uniform(-7.0, 6.0)];
+    (log_uniform(-3.0, 4.0), radius, log_uniform(0.2, 8.0), 20.0f32..90.0, log_uniform(-3.0, 5.0)).prop_map(
+        |(s, radius, gap, elevation_deg, spread)| Case {
+            s,
+            radius,
+            // At least 1.5 sides from the cube's centre: the light never touches the cube.
+            gap: gap.max(1.5 * s),
+            elevation_deg,
+            spread,
+        },
+    )
+}
+
+/// Checks every technique of the registry on `case`: V finite and in [0, 1]; the ground truths
+/// within [`TRUTHS_AGREE`] of the tracer, and showing the umbra where there must be one; every
+/// other technique within its bound of the tracer, or refusing with a message.
+///
+/// The bound for approximations: no worse than the hard shadow of a point light at the light's
+/// centre, plus 0.15 RMSE. The RMSE bounds the other tests state (0.05–0.13) hold on the suite's
+/// scenes, for lights they were calibrated on; across lights from a point to 1e6 m even the
+/// hard shadow map is far from the truth, and a technique that does worse than it by more than
+/// 0.15 (PCF's fixed kernel at a point light measured up to 0.07 at this size) has failed.
+fn check(e: &mut Engine, case: &Case) -> Result<(), TestCaseError> {
+    let scene = case.scene();
+    let cpu = ground_truth(Runs::Cpu);
+    let truth = e.render_and_capture(&scene, &settings(cpu, &[("samples", "1024")]));
+    let truth = truth.map_err(|err| TestCaseError::fail(format!("the tracer refused {case:?}: {err}")))?;
+    let mut point = scene.clone();
+    point.light.radius = 0.0;
+    let hard = e.render_and_capture(&point, &settings(cpu, &[("samples", "1")])).expect("a point light");
+    let hard_rmse = Metrics::between(&hard, &truth).unwrap().rmse;
+    let centre = truth.visibility_at(SIZE / 2, SIZE / 2);
+    if case.has_umbra() {
+        prop_assert!(centre < 0.5, "{case:?}: the tracer lost the umbra at the shadow's centre (V = {centre})");
+    }
+    for &t in TECHNIQUES {
+        let knobs = if t.kind == Kind::GroundTruth(Runs::Cpu) { &[][..] } else { t.sweep_knobs.short };
+        let frame = settings(t, knobs);
+        let c = match e.render_and_capture(&scene, &frame) {
+            Ok(c) => c,
+            Err(err) => {
+                let truth = matches!(t.kind, Kind::GroundTruth(_));
+                prop_assert!(!truth, "{}: a ground truth refused {case:?}: {err}", t.name);
+                prop_assert!(!err.to_string().trim().is_empty(), "{}: refused without a message", t.name);
+                continue;
+            }
+        };
+        let raw = c.raw_visibility.as_deref().expect("raw V");
+        let bad = raw.iter().filter(|v| !(0.0..=1.0).contains(*v)).count();
+        prop_assert!(bad == 0, "{}: {bad} pixels of V NaN or outside [0, 1] on {case:?}", t.name);
+        if matches!(t.kind, Kind::GroundTruth(_)) {
+            let rmse = rmse_off_hard_edges(&c, &truth);
+            prop_assert!(
+                rmse <= TRUTHS_AGREE,
+                "{}: RMSE {rmse:.4} off hard edges, over {TRUTHS_AGREE} on {case:?}",
+                t.name
+            );
+        } else {
+            let m = Metrics::between(&c, &truth).unwrap();
+            let bound = hard_rmse + 0.15;
+            prop_assert!(m.rmse <= bound, "{}: RMSE {:.4} over {bound:.4} on {case:?} ({m:?})", t.name, m.rmse);
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn every_technique_is_sound_across_the_accepted_numbers() {
+    let cases_env = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok());
+    let config =
+        Config { cases: cases_env.unwrap_or(6), max_shrink_iters: 16, failure_persistence: None, ..Config::default() };
+    let e = std::cell::RefCell::new(engine());
+    e.borrow_mut().set_raw_visibility(true).unwrap();
+    // The same cases every run by default; PROPTEST_CASES explores further from the same seed.
+    let mut runner = TestRunner::new_with_rng(config, TestRng::deterministic_rng(RngAlgorithm::ChaCha));
+    let result = runner.run(&cases(), |case| check(&mut e.borrow_mut(), &case));
+    let mut e = e.into_inner();
+    e.set_raw_visibility(false).unwrap();
+    finish(e);
+    if let Err(error) = result {
+        panic!("{error}");
+    }
+}
