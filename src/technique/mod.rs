@@ -50,6 +50,25 @@ pub trait Technique {
     fn destroy(self: Box<Self>, ctx: &Context);
 }
 
+/// Refuses, naming the caster, a light so large or so close that some caster sees it wider
+/// than `max_deg` (half-angle): past it, `technique`'s approximation stands for nothing, which
+/// `why` says, with what to use instead.
+pub(crate) fn refuse_wide_lights(scene: &crate::scene::Scene, technique: &str, max_deg: f64, why: &str) -> Result<()> {
+    let (centre, radius) = (scene.light.position.as_dvec3(), scene.light.radius as f64);
+    for o in scene.objects.iter().filter(|o| o.casts) {
+        let b = o.bounds();
+        let gap = (b.min.as_dvec3() - centre).max(centre - b.max.as_dvec3()).max(glam::DVec3::ZERO).length();
+        let angle = if gap > radius { (radius / gap).asin().to_degrees() } else { 90.0 };
+        if angle > max_deg {
+            return Err(crate::error::Error::Invalid(format!(
+                "{technique}: the light (radius {radius:e} m) spans {angle:.1}° from caster `{}`, over the {max_deg}° {why}",
+                o.name
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// The first inputs of every resolve that reads the camera's surfaces, in binding order: the
 /// frame's globals, the technique's `light` (view) buffer, camera depth, camera normal.
 pub(crate) fn surface_inputs<'a>(

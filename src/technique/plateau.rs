@@ -31,7 +31,7 @@ use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params};
 use super::registry::{CostGoal, Kind, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::{Technique, clear_visibility, resolve, surface_inputs};
+use super::{Technique, clear_visibility, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -120,25 +120,6 @@ const PLATEAU_FORMAT: vk::Format = vk::Format::R16_UNORM;
 /// 0.87 against the ray tracer, streaks of capped cones to the horizon).
 const MAX_LIGHT_ANGLE_DEG: f64 = 60.0;
 
-/// Refuses, naming the caster, a light so large or so close that some caster sees it wider
-/// than [`MAX_LIGHT_ANGLE_DEG`].
-fn refuse_lights_without_umbra(scene: &crate::scene::Scene) -> Result<()> {
-    let (centre, radius) = (scene.light.position.as_dvec3(), scene.light.radius as f64);
-    for o in scene.objects.iter().filter(|o| o.casts) {
-        let b = o.bounds();
-        let gap = (b.min.as_dvec3() - centre).max(centre - b.max.as_dvec3()).max(glam::DVec3::ZERO).length();
-        let angle = if gap > radius { (radius / gap).asin().to_degrees() } else { 90.0 };
-        if angle > MAX_LIGHT_ANGLE_DEG {
-            return Err(crate::error::Error::Invalid(format!(
-                "plateau: the light (radius {radius:e} m) spans {angle:.1}° from caster `{}`, over the \
-                 {MAX_LIGHT_ANGLE_DEG}° a plateau's hard umbra and cones can stand for; use pcss, smoothie or a \
-                 ground truth",
-                o.name
-            )));
-        }
-    }
-    Ok(())
-}
 const CONE_SEGMENTS: u32 = 32;
 
 /// What a caster's cached sides were built from: rebuilt only when any of it changes.
@@ -259,7 +240,12 @@ impl Technique for Plateau {
         let ctx = frame.ctx;
         let plane = ReceiverPlane::ground(ground.height);
         let scene_light = &frame.scene.light;
-        refuse_lights_without_umbra(frame.scene)?;
+        refuse_wide_lights(
+            frame.scene,
+            "plateau",
+            MAX_LIGHT_ANGLE_DEG,
+            "a plateau's hard umbra and cones can stand for; use pcss, smoothie or a ground truth",
+        )?;
         let size = if params.is_on(&SIZE_MODE) {
             PenumbraSize::Haines { factor: params.get(&HAINES_FACTOR) as f32 }
         } else {
