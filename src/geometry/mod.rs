@@ -1,5 +1,5 @@
-//! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting and light
-//! sampling.
+//! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting, light
+//! sampling and shadow volumes.
 
 pub mod adjacency;
 mod bounds;
@@ -8,6 +8,7 @@ mod light_frustum;
 mod light_samples;
 pub mod plateau;
 mod projection;
+pub mod shadow_volume;
 pub mod shapes;
 pub mod silhouette;
 pub mod smoothie;
@@ -16,5 +17,5 @@ pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
 pub use bounds::Aabb;
 pub use clip::{Hexahedron, intersection_points};
 pub use light_frustum::{LightFrustum, fit_spot_frustum};
-pub use light_samples::{Cap, cap_points, visible_cap};
+pub use light_samples::{Cap, cap_points, light_points, visible_cap};
 pub use projection::{CameraProjection, Projection};

@@ -24,7 +24,7 @@ use super::{Technique, clear_visibility, resolve};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::{LightSample, LightView};
-use crate::geometry::{Aabb, cap_points, fit_spot_frustum, visible_cap};
+use crate::geometry::{Aabb, fit_spot_frustum, light_points};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, Milestones, PerFrame,
     Pipeline, RenderPass, Target, TargetDesc, draw_fullscreen, ensure, shaders, transition,
@@ -100,14 +100,7 @@ impl Reference {
         let light = &frame.scene.light;
         let casters: Vec<Vec3> = frame.draws.iter().filter(|d| d.casts).flat_map(|d| d.bounds.corners()).collect();
         let aim = light.target.unwrap_or_else(|| Aabb::from_points(casters.iter().copied()).center());
-        // A point light has one point to sample.
-        let points = if light.radius > 0.0 {
-            let cap = visible_cap(light.position, light.radius, frame.receivers_in_view);
-            cap_points(light.position, light.radius, cap, n)
-        } else {
-            vec![light.position]
-        };
-        points
+        light_points(light.position, light.radius, frame.receivers_in_view, n)
             .into_iter()
             .map(|q| {
                 let frustum = fit_spot_frustum(q, aim, &casters, frame.receivers_in_view);
