@@ -66,7 +66,7 @@ struct SilhouetteParams {
 // uniform buffer.
 struct SampleView {
     mat4 transform;  // world -> clip: the camera's (volumes), or the camera's * Blinn's (planar)
-    vec4 light;      // xyz: the light point
+    vec4 light;      // xyz: the light point; w: volumes' reach (0: to infinity, w = 0)
     vec4 plane;      // planar: the receiver plane, n.xyz and w = -n.o
     vec4 tolerance;  // planar: x = how far off the plane a surface may be and still be on it
     vec4 pad[9];

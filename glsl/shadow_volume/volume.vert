@@ -17,8 +17,12 @@ layout(location = 2) in float in_object;
 void main() {
     ObjectData object = objects[uint(in_object)];
     precise vec4 world = object.model * vec4(in_position, 1.0);
-    if (in_at_infinity > 0.5) {
-        gl_Position = frame.view_proj * vec4(world.xyz - view.light.xyz, 0.0);
+    vec3 away = world.xyz - view.light.xyz;
+    if (in_at_infinity > 0.5 && view.light.w > 0.0) {
+        // Orthographic views: far past every receiver instead (src/technique/shadow_volume.rs).
+        gl_Position = frame.view_proj * vec4(world.xyz + normalize(away) * view.light.w, 1.0);
+    } else if (in_at_infinity > 0.5) {
+        gl_Position = frame.view_proj * vec4(away, 0.0);
     } else {
         precise vec4 position = frame.view_proj * world;
         gl_Position = position;

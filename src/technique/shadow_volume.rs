@@ -7,18 +7,24 @@
 //! caster's light-facing triangles, and the dark caps at infinity), then the stencil resolved
 //! into V: 0 is lit, anything else shadowed ([`Accumulation`]), and `resolve`.
 //!
+//! Reach. Perspective views extrude to infinity (w = 0); orthographic ones, where points at
+//! infinity along the view axis collapse into one and the dark caps would vanish, extrude far
+//! past every receiver instead ([`FINITE_REACH`]).
+//!
 //! Depth. The volumes test against the camera prepass's depth, copied bit for bit into a
 //! depth-stencil target of our own (`glsl/shadow_volume/depth.frag`): one full-screen pass,
 //! cheaper than drawing the scene again, and exactly the surfaces V is reported at. Depth
 //! clamping (the device's `depthClamp`) keeps volumes whole past the far plane and in front of
 //! the near one, so no volume is ever too short or too long, with the camera's own fitted
-//! projection, perspective or orthographic (an infinite far plane exists only for the first).
+//! projection, perspective or orthographic (an infinite far plane would serve only the first).
 //!
 //! Counting. z-pass (front faces in front of the surface add, back faces subtract) is wrong
 //! where a view ray starts inside a volume; z-fail (Carmack's reverse: count what lies behind,
 //! with both caps) is not. With depth clamping the near plane cuts nothing, so what remains is
-//! the view rays' start, the eye (or, orthographic, infinitely far behind it): the engine picks
-//! z-fail exactly when that can lie in a caster's shadow, `counting` forces either. No depth
+//! the view rays' start, the eye: the engine picks z-fail exactly when the eye can lie in a
+//! caster's shadow (orthographic rays start infinitely far behind, outside every volume),
+//! `counting` forces either. Deviation from the papers' "near plane" test: with the near plane
+//! unclipped it is the eye, not the near plane, that matters. No depth
 //! bias anywhere: self-shadowing comes from the counts (light caps have the surface's depth to
 //! the bit, `glsl/shadow_volume/volume.vert`) and from the facet facing away from the point.
 //!
@@ -38,8 +44,8 @@ use super::{Technique, clear_visibility};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SampleView;
-use crate::geometry::Projection;
-use crate::geometry::shadow_volume::{ShadowVolume, is_open, nesting_bound, shadow_volume, view_may_start_in_shadow};
+use crate::geometry::{Aabb, Projection};
+use crate::geometry::shadow_volume::{ShadowVolume, eye_may_be_in_shadow, is_open, nesting_bound, shadow_volume};
 use crate::geometry::silhouette::{Caster, light_facing};
 use crate::gpu::{
     Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
@@ -72,6 +78,9 @@ const COUNT_MASK: u32 = 0x7F;
 const SHADOWED_BY_A_GROUP: u32 = 0x80;
 /// Floats per volume vertex: object-space position, at infinity (0 or 1), object index.
 const VERTEX_FLOATS: usize = 5;
+/// Orthographic views: how far volumes reach, in multiples of the farthest scene point's
+/// distance from the light (a dark cap's chord stays beyond the scene up to 170° of caster).
+const FINITE_REACH: f32 = 1e3;
 
 /// What a caster's volumes were built from: rebuilt only when any of it changes.
 #[derive(Clone, Debug, PartialEq)]
@@ -240,18 +249,27 @@ impl ShadowVolumes {
         (out, ranges)
     }
 
+    /// How far volumes reach past their caster: `None`, to infinity (w = 0), for a perspective
+    /// camera. An orthographic one sees points at infinity along its axis as one point, so its
+    /// dark caps would vanish; there the volumes end [`FINITE_REACH`] scene sizes out, far
+    /// beyond every receiver, and, depth clamping keeping what lies behind the camera, every
+    /// view ray starts outside them: z-pass is exact.
+    fn extrusion(frame: &FrameInputs<'_>, points: &[Vec3]) -> Option<f32> {
+        let Projection::Orthographic { .. } = frame.scene.camera.projection else { return None };
+        let scene = frame.draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
+        let far = points.iter().flat_map(|q| scene.corners().map(|c| (c - *q).length())).fold(0.0, f32::max);
+        Some(FINITE_REACH * far)
+    }
+
     /// Whether this frame counts by z-fail.
     fn z_fail(frame: &FrameInputs<'_>, params: &Params, points: &[Vec3]) -> bool {
         match params.get(&COUNTING) as u32 {
             1 => false,
             2 => true,
+            _ if Self::extrusion(frame, points).is_some() => false,
             _ => {
-                let eye = match frame.scene.camera.projection {
-                    Projection::Perspective { .. } => Some(frame.camera.position),
-                    Projection::Orthographic { .. } => None,
-                };
                 let casters: Vec<_> = frame.draws.iter().filter(|d| d.casts).map(|d| d.bounds).collect();
-                points.iter().any(|q| view_may_start_in_shadow(*q, eye, frame.camera.forward, &casters))
+                points.iter().any(|q| eye_may_be_in_shadow(*q, frame.camera.position, &casters))
             }
         }
     }
@@ -265,6 +283,7 @@ impl Technique for ShadowVolumes {
         let ctx = frame.ctx;
         let points = Accumulation::points(frame, params.get(&SAMPLES) as usize);
         let z_fail = Self::z_fail(frame, params, &points);
+        let reach = Self::extrusion(frame, &points).unwrap_or(0.0);
         self.build(frame, &points);
         let groups = self.groups(frame);
         let (vertices, ranges) = self.vertices(frame, points.len(), &groups);
@@ -278,7 +297,7 @@ impl Technique for ShadowVolumes {
             .iter()
             .map(|q| SampleView {
                 transform: frame.camera.view_proj,
-                light: q.extend(1.0),
+                light: q.extend(reach),
                 plane: Vec4::ZERO,
                 tolerance: Vec4::ZERO,
                 pad: [Vec4::ZERO; 9],
