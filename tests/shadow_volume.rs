@@ -171,3 +171,88 @@ fn counts_beyond_the_stencils_bits_stay_shadowed() {
     finish(e);
 }
 
+
+/// A post whose top is 4 m above the light: the volume of the part above the light points up
+/// and away, never onto the ground; the ray tracer agrees everywhere but at the edges.
+#[test]
+fn a_caster_reaching_above_the_light() {
+    let post = "[[object]]\nshape = \"box\"\nsize = [0.3, 6.0, 0.3]\nposition = [0.0, 3.0, 0.0]\n";
+    let s = top_down(0.0, 4.0, [2.0, 2.0, 0.0], 0.0, post);
+    let mut e = engine();
+    let ray = render_with(&mut e, &s, "raytrace", &[], 64);
+    for sets in [&[][..], ZPASS, ZFAIL] {
+        assert_same_hard_shadow(&render_with(&mut e, &s, "shadow-volume", sets, 64), &ray, &format!("{sets:?}"));
+    }
+    finish(e);
+}
+
+/// The same hard shadow at a millimetre and at ten kilometres: nothing depends on the scale.
+#[test]
+fn scene_scales_from_a_millimetre_to_ten_kilometres() {
+    let mut e = engine();
+    let one = render_with(&mut e, &common::wall(1.0, 0.0), "shadow-volume", &[], 64);
+    assert!(dark_pixels(&one) > 300);
+    for scale in [1e-3, 1e4] {
+        let s = common::wall(scale, 0.0);
+        for sets in [ZPASS, ZFAIL] {
+            let v = render_with(&mut e, &s, "shadow-volume", sets, 64);
+            assert_same_hard_shadow(&v, &one, &format!("scale {scale} {sets:?}"));
+        }
+    }
+    finish(e);
+}
+
+/// The bottomless cube (models/cube_no_bottom.obj) and a cube with a fin on one edge (three
+/// faces there): boundary and non-manifold edges, every triangle blocking from its lit side.
+/// Seen from above with the light below the open side, only the inside faces block.
+#[test]
+fn open_and_non_manifold_meshes() {
+    let dir = std::env::temp_dir().join(format!("softshadow-volumes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fin = dir.join("fin.obj");
+    std::fs::write(
+        &fin,
+        "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\nv -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\n\
+         v 0.5 0.5 0.5\nv -0.5 0.5 0.5\nv -0.5 1.0 0.5\nv 0.5 1.0 0.5\n\
+         f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\nf 4 8 7\nf 4 7 3\nf 1 2 6\nf 1 6 5\n\
+         f 8 7 10\nf 8 10 9\n",
+    )
+    .unwrap();
+    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube_no_bottom.obj");
+    let mut e = engine();
+    for (mesh, light) in [(models, [2.0, 5.0, 1.0]), (models, [0.6, 0.3, 0.2]), (fin.to_str().unwrap(), [1.5, 4.0, -2.5])] {
+        let object = format!("[[object]]\nshape = \"mesh\"\nmesh = \"{mesh}\"\nposition = [0.0, 1.2, 0.0]\n");
+        let s = top_down(0.0, 3.0, light, 0.0, &object);
+        let adjacency = &s.objects[0].mesh.adjacency;
+        assert!(adjacency.boundary + adjacency.non_manifold > 0, "{mesh} is open or non-manifold");
+        let ray = render_with(&mut e, &s, "raytrace", &[], 64);
+        assert!(dark_pixels(&ray) > 50, "{mesh}: a shadow");
+        for sets in [ZPASS, ZFAIL] {
+            let v = render_with(&mut e, &s, "shadow-volume", sets, 64);
+            assert_same_hard_shadow(&v, &ray, &format!("{mesh} {light:?} {sets:?}"));
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    finish(e);
+}
+
+/// Soft by accumulation: N hard shadows from the reference's points converge to the
+/// reference; at N = 64 the error is a fraction of the hard shadow's. A light as large as the
+/// caster stays sane.
+#[test]
+fn accumulation_converges_to_the_reference() {
+    let mut e = engine();
+    for technique in ["shadow-volume", "planar"] {
+        let s = common::wall(1.0, 0.25);
+        let truth = common::reference(&mut e, &s, 64);
+        let rmse: Vec<f64> = ["1", "16", "64"]
+            .iter()
+            .map(|n| Metrics::between(&render_with(&mut e, &s, technique, &[("samples", n)], 64), &truth).unwrap().rmse)
+            .collect();
+        assert!(rmse[2] < rmse[1] && rmse[1] < rmse[0], "{technique}: {rmse:?}");
+        assert!(rmse[2] < 0.25 * rmse[0] && rmse[2] < 0.02, "{technique}: {rmse:?}");
+        let huge = render_with(&mut e, &common::wall(1.0, 1.0), technique, &[("samples", "16")], 64);
+        assert!(huge.visibility.iter().any(|&v| v > 0 && v < 65535), "{technique}: a penumbra");
+    }
+    finish(e);
+}

@@ -96,10 +96,12 @@ impl Accumulation {
         Ok(Accumulation { lit: lit.keep(), shadowed: shadowed.keep(), resolve, views: None, sums: None })
     }
 
-    /// The light points of this frame: `n` over the part of the light the receivers see.
+    /// The light points of this frame: `n` over the part of the light the receivers see; one
+    /// is the centre, the hard shadow every other technique's hard mode casts.
     pub fn points(frame: &FrameInputs<'_>, n: usize) -> Vec<Vec3> {
         let light = &frame.scene.light;
-        light_points(light.position, light.radius, frame.receivers_in_view, n)
+        let radius = if n == 1 { 0.0 } else { light.radius };
+        light_points(light.position, radius, frame.receivers_in_view, n)
     }
 
     /// Uploads this frame's views (one per light point) and sizes the sums like `extent`.

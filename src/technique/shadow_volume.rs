@@ -311,6 +311,10 @@ impl Technique for ShadowVolumes {
         let cmd = frame.cmd;
         let timed = points.len() == 1;
         let several = groups.len() > 1;
+        // z-pass needs no caps, but for finite volumes (orthographic views) rays from behind
+        // the camera cross the dark caps; light caps in front of a surface would hide it, so
+        // drawing them as well changes nothing.
+        let caps = z_fail || reach > 0.0;
         span(frame, !timed, "accumulate");
         for (p, point_ranges) in ranges.chunks(groups.len()).enumerate() {
             let view = Descriptor::Buffer(self.accumulation.view(frame.slot, p));
@@ -332,21 +336,23 @@ impl Technique for ShadowVolumes {
                 if let Some(vb) = vb {
                     draw_vertices(ctx, cmd, vb, range.first, range.sides);
                 }
-                if several && !z_fail {
+                if several && !caps {
                     self.mark.bind(ctx, cmd, &[])?;
                     draw_fullscreen(ctx, cmd);
                 }
                 pass.end(ctx, cmd);
                 end_span(frame, timed);
-                if z_fail {
+                if caps {
                     span(frame, timed, "caps");
                     transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, false)]);
                     let pass = RenderPass::begin(ctx, cmd, &[], Some(Attachment { target: ds, clear: None }));
                     if let Some(vb) = vb {
-                        self.zfail.bind(ctx, cmd, &inputs)?;
+                        counting.bind(ctx, cmd, &inputs)?;
                         draw_vertices(ctx, cmd, vb, range.first + range.sides, range.caps);
-                        self.zfail_turned.bind(ctx, cmd, &inputs)?;
-                        draw_vertices(ctx, cmd, vb, range.first + range.sides + range.caps, range.turned);
+                        if z_fail {
+                            self.zfail_turned.bind(ctx, cmd, &inputs)?;
+                            draw_vertices(ctx, cmd, vb, range.first + range.sides + range.caps, range.turned);
+                        }
                     }
                     if several {
                         self.mark.bind(ctx, cmd, &[])?;
