@@ -10,8 +10,8 @@ use gpu_allocator::MemoryLocation;
 use softshadow::Error;
 use softshadow::gpu::{
     Access, Attachment, Buffer, Context, ContextOptions, DeviceFilter, EmbedderHandles, FrameRing, Ownership,
-    RenderPass, Semaphores, Target, TargetDesc, copy_to_buffer, copy_to_host, required_device_extensions,
-    required_core_features, required_vulkan13_features, transition,
+    RenderPass, Semaphores, Target, TargetDesc, copy_to_buffer, copy_to_host, required_core_features,
+    required_device_extensions, required_vulkan13_features, transition,
 };
 
 const SIDE: u32 = 4;

@@ -56,14 +56,25 @@ fn exact_on_the_plane_once_where_projections_overlap_and_nothing_elsewhere() {
     let (on_ground, wrong, elsewhere) = compare(&planar, &ray);
     let dark_ground = (0..ray.visibility.len()).filter(|&i| ground(&ray, i) && ray.visibility[i] < 32768).count();
     assert!(on_ground > 5000 && dark_ground > 300, "{on_ground} ground px, {dark_ground} in shadow");
-    assert!(wrong.is_empty(), "{} ground px differ from the ray tracer, first {:?}", wrong.len(), &wrong[..wrong.len().min(6)]);
-    assert!(elsewhere.is_empty(), "{} px off the plane not 1, first {:?}", elsewhere.len(), &elsewhere[..elsewhere.len().min(6)]);
+    assert!(
+        wrong.is_empty(),
+        "{} ground px differ from the ray tracer, first {:?}",
+        wrong.len(),
+        &wrong[..wrong.len().min(6)]
+    );
+    assert!(
+        elsewhere.is_empty(),
+        "{} px off the plane not 1, first {:?}",
+        elsewhere.len(),
+        &elsewhere[..elsewhere.len().min(6)]
+    );
     // The small box's top (x = -1.2, z = 0: column 29, row 48) is shadowed in truth.
     assert!(!ground(&ray, 48 * 96 + 29), "the small box's top");
     assert!(ray.visibility_at(29, 48) < 0.5 && planar.visibility_at(29, 48) == 1.0);
     // Where the boxes' projections overlap the ground is dark once, not lit by a stencil that
     // went past "shadowed": the whole shadow is V = 0, never in between.
-    let dark: Vec<u16> = (0..planar.visibility.len()).filter(|&i| ground(&ray, i)).map(|i| planar.visibility[i]).collect();
+    let dark: Vec<u16> =
+        (0..planar.visibility.len()).filter(|&i| ground(&ray, i)).map(|i| planar.visibility[i]).collect();
     assert!(dark.iter().all(|&v| v == 0 || v == 65535), "a hard shadow is 0 or 1");
     finish(e);
 }

@@ -171,7 +171,6 @@ fn counts_beyond_the_stencils_bits_stay_shadowed() {
     finish(e);
 }
 
-
 /// A post whose top is 4 m above the light: the volume of the part above the light points up
 /// and away, never onto the ground; the ray tracer agrees everywhere but at the edges.
 #[test]
@@ -220,7 +219,9 @@ fn open_and_non_manifold_meshes() {
     .unwrap();
     let models = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube_no_bottom.obj");
     let mut e = engine();
-    for (mesh, light) in [(models, [2.0, 5.0, 1.0]), (models, [0.6, 0.3, 0.2]), (fin.to_str().unwrap(), [1.5, 4.0, -2.5])] {
+    for (mesh, light) in
+        [(models, [2.0, 5.0, 1.0]), (models, [0.6, 0.3, 0.2]), (fin.to_str().unwrap(), [1.5, 4.0, -2.5])]
+    {
         let object = format!("[[object]]\nshape = \"mesh\"\nmesh = \"{mesh}\"\nposition = [0.0, 1.2, 0.0]\n");
         let s = top_down(0.0, 3.0, light, 0.0, &object);
         let adjacency = &s.objects[0].mesh.adjacency;

@@ -48,11 +48,7 @@ pub fn cap_points(center: Vec3, radius: f32, cap: Cap, n: usize) -> Vec<Vec3> {
 /// The points accumulation renders a hard shadow from: `n` of [`cap_points`] over the
 /// [`visible_cap`] of `receivers`, or the centre alone for a point light.
 pub fn light_points(center: Vec3, radius: f32, receivers: &[Vec3], n: usize) -> Vec<Vec3> {
-    if radius > 0.0 {
-        cap_points(center, radius, visible_cap(center, radius, receivers), n)
-    } else {
-        vec![center]
-    }
+    if radius > 0.0 { cap_points(center, radius, visible_cap(center, radius, receivers), n) } else { vec![center] }
 }
 
 #[cfg(test)]

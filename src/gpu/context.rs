@@ -11,8 +11,8 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::debug::{VALIDATION_LAYER, ValidationLog, messenger_info};
 use super::device::{
-    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_device_extensions,
-    required_core_features, required_vulkan13_features,
+    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_core_features,
+    required_device_extensions, required_vulkan13_features,
 };
 use crate::error::{Error, Result, VkContext};
 

@@ -108,7 +108,8 @@ impl Accumulation {
     pub fn prepare(&mut self, frame: &FrameInputs<'_>, views: &[SampleView], extent: vk::Extent2D) -> Result<()> {
         let ctx = frame.ctx;
         let bytes = views.len() as u64 * VIEW_BYTES;
-        let buffer = PerFrame::ensure(ctx, &mut self.views, "sample views", bytes, vk::BufferUsageFlags::UNIFORM_BUFFER)?;
+        let buffer =
+            PerFrame::ensure(ctx, &mut self.views, "sample views", bytes, vk::BufferUsageFlags::UNIFORM_BUFFER)?;
         buffer.write(frame.slot, cast_slice(views));
         ensure(ctx, &mut self.sums, TargetDesc::color("accumulated sums", SUM_FORMAT, extent.width, extent.height))
     }
@@ -130,7 +131,8 @@ impl Accumulation {
             cmd,
             &mut [(sums, Access::COLOR_WRITE, i == 0), (depth_stencil, Access::DEPTH_STENCIL_WRITE, false)],
         );
-        let target = if i == 0 { Attachment::clear_color(sums, [0.0; 4]) } else { Attachment { target: sums, clear: None } };
+        let target =
+            if i == 0 { Attachment::clear_color(sums, [0.0; 4]) } else { Attachment { target: sums, clear: None } };
         let pass = RenderPass::begin(ctx, cmd, &[target], Some(Attachment { target: depth_stencil, clear: None }));
         let inputs = [
             Descriptor::Buffer(frame.globals),

@@ -26,8 +26,8 @@ use crate::frame::interface::SampleView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
 use crate::geometry::plateau::ReceiverPlane;
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, Guard, Pipeline, PipelineDesc, RenderPass, Target,
-    TargetDesc, draw_fullscreen, ensure, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, Guard, Pipeline, PipelineDesc, RenderPass, Target, TargetDesc,
+    draw_fullscreen, ensure, shaders, transition,
 };
 use crate::technique::knobs::Params;
 
@@ -123,8 +123,12 @@ impl Technique for Planar {
             };
             let pass = RenderPass::begin(ctx, cmd, &[], Some(attachment));
             if p == 0 {
-                let inputs =
-                    [Descriptor::Buffer(frame.globals), view, Descriptor::Image(frame.depth), Descriptor::Image(frame.normal)];
+                let inputs = [
+                    Descriptor::Buffer(frame.globals),
+                    view,
+                    Descriptor::Image(frame.depth),
+                    Descriptor::Image(frame.normal),
+                ];
                 self.plane.bind(ctx, cmd, &inputs)?;
                 draw_fullscreen(ctx, cmd);
             }

@@ -44,12 +44,12 @@ use super::{Technique, clear_visibility};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SampleView;
-use crate::geometry::{Aabb, Projection};
 use crate::geometry::shadow_volume::{ShadowVolume, eye_may_be_in_shadow, is_open, nesting_bound, shadow_volume};
 use crate::geometry::silhouette::{Caster, light_facing};
+use crate::geometry::{Aabb, Projection};
 use crate::gpu::{
-    Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
-    TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition, Access,
+    Access, Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
+    TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
 };
 use crate::scene::MeshId;
 
@@ -192,7 +192,8 @@ impl ShadowVolumes {
             if !self.bounds.iter().any(|(id, _)| *id == o.mesh.id()) {
                 self.bounds.push((o.mesh.id(), nesting_bound(&caster, two_sided)));
             }
-            let volumes = points.iter().map(|q| shadow_volume(&caster, &light_facing(&caster, *q), two_sided)).collect();
+            let volumes =
+                points.iter().map(|q| shadow_volume(&caster, &light_facing(&caster, *q), two_sided)).collect();
             *cached = Some((key, volumes));
         }
     }
@@ -323,8 +324,11 @@ impl Technique for ShadowVolumes {
                 let first = p == 0 && g == 0;
                 span(frame, timed, "volumes");
                 transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, first)]);
-                let attachment =
-                    if first { Attachment::clear_depth_stencil(ds, 0.0, 0) } else { Attachment { target: ds, clear: None } };
+                let attachment = if first {
+                    Attachment::clear_depth_stencil(ds, 0.0, 0)
+                } else {
+                    Attachment { target: ds, clear: None }
+                };
                 let pass = RenderPass::begin(ctx, cmd, &[], Some(attachment));
                 if first {
                     self.depth_copy.bind(ctx, cmd, &[Descriptor::Image(frame.depth)])?;
