@@ -237,23 +237,50 @@ fn open_and_non_manifold_meshes() {
     finish(e);
 }
 
-/// Soft by accumulation: N hard shadows from the reference's points converge to the
-/// reference; at N = 64 the error is a fraction of the hard shadow's. A light as large as the
-/// caster stays sane.
+/// Soft by accumulation: N hard shadows from the reference's points, weighted by solid angle,
+/// converge to the truth (the CPU ray tracer) as the reference does. Measured RMSE on the wall
+/// with a light as wide as it (radius 1 m): 0.185, 0.043, 0.014 at N = 1, 16, 64, both
+/// techniques alike; the reference itself at N = 256: 0.0053.
 #[test]
-fn accumulation_converges_to_the_reference() {
+fn accumulation_converges_to_the_truth() {
     let mut e = engine();
+    let s = common::wall(1.0, 1.0);
+    let truth = render_with(&mut e, &s, "raytrace", &[], 64);
     for technique in ["shadow-volume", "planar"] {
-        let s = common::wall(1.0, 0.25);
-        let truth = common::reference(&mut e, &s, 64);
         let rmse: Vec<f64> = ["1", "16", "64"]
             .iter()
             .map(|n| Metrics::between(&render_with(&mut e, &s, technique, &[("samples", n)], 64), &truth).unwrap().rmse)
             .collect();
         assert!(rmse[2] < rmse[1] && rmse[1] < rmse[0], "{technique}: {rmse:?}");
-        assert!(rmse[2] < 0.25 * rmse[0] && rmse[2] < 0.02, "{technique}: {rmse:?}");
-        let huge = render_with(&mut e, &common::wall(1.0, 1.0), technique, &[("samples", "16")], 64);
-        assert!(huge.visibility.iter().any(|&v| v > 0 && v < 65535), "{technique}: a penumbra");
+        assert!(rmse[0] > 0.15 && rmse[1] < 0.05 && rmse[2] < 0.017, "{technique}: {rmse:?}");
+    }
+    finish(e);
+}
+
+#[test]
+#[ignore]
+fn scratch_errors() {
+    let mut e = engine();
+    for (name, s) in
+        [("wall 0.25", common::wall(1.0, 0.25)), ("wall 1", common::wall(1.0, 1.0)), ("plate", suite_scene("plate"))]
+    {
+        let truth = render_with(&mut e, &s, "raytrace", &[], 64);
+        let reference = common::reference(&mut e, &s, 64);
+        eprintln!("{name} reference(256) vs raytrace {:.4}", Metrics::between(&reference, &truth).unwrap().rmse);
+        for technique in ["shadow-volume", "planar"] {
+            let r: Vec<String> = ["1", "16", "64", "128", "256", "512"]
+                .iter()
+                .map(|n| {
+                    format!(
+                        "{n}: {:.4}",
+                        Metrics::between(&render_with(&mut e, &s, technique, &[("samples", n)], 64), &truth)
+                            .unwrap()
+                            .rmse
+                    )
+                })
+                .collect();
+            eprintln!("{name} {technique} {}", r.join(", "));
+        }
     }
     finish(e);
 }

@@ -15,7 +15,7 @@ layout(location = 0) in vec2 in_uv;
 void main() {
     Surface s = read_surface(frame, camera_depth, camera_normal, in_uv);
     float h = dot(s.p, view.plane.xyz) + view.plane.w;
-    if (!s.receives || abs(h) > view.tolerance.x || dot(s.n, view.plane.xyz) < 0.99) {
+    if (!s.receives || abs(h) > view.tolerance.x) {
         discard;
     }
 }

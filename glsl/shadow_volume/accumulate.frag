@@ -22,9 +22,8 @@ void main() {
     if (!s.receives) {
         return; // the resolve writes V = 1 where nothing was summed
     }
-    vec3 q = view.light.xyz;
-    float weight = light_sample_weight(frame.light, q, s.p);
-    // A caster's side turned from q is dark whatever the count says: exact self-shadowing.
-    float lit = SHADOWED || hides_itself(s, q) ? 0.0 : 1.0;
-    out_sum = vec2(weight * lit, weight);
+    float weight = light_sample_weight(frame.light, view.light.xyz, s.p);
+    // Self-shadowing needs no test of its own: a caster's side turned from the light lies in its
+    // own volume, and its lit side on a light cap of the same depth, which the count resolves.
+    out_sum = vec2(SHADOWED ? 0.0 : weight, weight);
 }

@@ -25,8 +25,8 @@
 //! caster's shadow (orthographic rays start infinitely far behind, outside every volume),
 //! `counting` forces either. Deviation from the papers' "near plane" test: with the near plane
 //! unclipped it is the eye, not the near plane, that matters. No depth
-//! bias anywhere: self-shadowing comes from the counts (light caps have the surface's depth to
-//! the bit, `glsl/shadow_volume/volume.vert`) and from the facet facing away from the point.
+//! bias anywhere: self-shadowing comes from the counts alone (light caps have the surface's
+//! depth to the bit, `glsl/shadow_volume/volume.vert`).
 //!
 //! Counts beyond the stencil's bits: volumes are counted modulo 128 in the low 7 bits, casters
 //! taken in groups whose nesting bounds (`nesting_bound`) sum to at most 127, and each group's
