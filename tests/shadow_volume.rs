@@ -256,31 +256,3 @@ fn accumulation_converges_to_the_truth() {
     }
     finish(e);
 }
-
-#[test]
-#[ignore]
-fn scratch_errors() {
-    let mut e = engine();
-    for (name, s) in
-        [("wall 0.25", common::wall(1.0, 0.25)), ("wall 1", common::wall(1.0, 1.0)), ("plate", suite_scene("plate"))]
-    {
-        let truth = render_with(&mut e, &s, "raytrace", &[], 64);
-        let reference = common::reference(&mut e, &s, 64);
-        eprintln!("{name} reference(256) vs raytrace {:.4}", Metrics::between(&reference, &truth).unwrap().rmse);
-        for technique in ["shadow-volume", "planar"] {
-            let r: Vec<String> = ["1", "16", "64", "128", "256", "512"]
-                .iter()
-                .map(|n| {
-                    format!(
-                        "{n}: {:.4}",
-                        Metrics::between(&render_with(&mut e, &s, technique, &[("samples", n)], 64), &truth)
-                            .unwrap()
-                            .rmse
-                    )
-                })
-                .collect();
-            eprintln!("{name} {technique} {}", r.join(", "));
-        }
-    }
-    finish(e);
-}
