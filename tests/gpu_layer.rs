@@ -10,8 +10,8 @@ use gpu_allocator::MemoryLocation;
 use softshadow::Error;
 use softshadow::gpu::{
     Access, Attachment, Buffer, Context, ContextOptions, DeviceFilter, EmbedderHandles, FrameRing, Ownership,
-    RenderPass, Semaphores, Target, TargetDesc, copy_to_buffer, copy_to_host, required_device_extensions,
-    required_vulkan13_features, transition,
+    RenderPass, Semaphores, Target, TargetDesc, copy_to_buffer, copy_to_host, required_core_features,
+    required_device_extensions, required_vulkan13_features, transition,
 };
 
 const SIDE: u32 = 4;
@@ -308,9 +308,11 @@ impl Embedder {
             [vk::DeviceQueueCreateInfo::default().queue_family_index(self.queue_family).queue_priorities(&priorities)];
         let names: Vec<_> = extensions.iter().map(|e| e.as_ptr()).collect();
         let mut v13 = required_vulkan13_features();
+        let core = required_core_features();
         let ci = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_ci)
             .enabled_extension_names(&names)
+            .enabled_features(&core)
             .push_next(&mut v13);
         unsafe { self.instance.create_device(self.physical, &ci, None) }.unwrap()
     }
@@ -324,6 +326,7 @@ impl Embedder {
             queue_family: self.queue_family,
             queue_index: 0,
             enabled_features: required_vulkan13_features(),
+            enabled_core_features: required_core_features(),
         }
     }
 

@@ -62,4 +62,16 @@ struct SilhouetteParams {
     vec4 pad[10];
 };
 
+// One hard shadow of an accumulation (shadow-volume, planar): the light point it is cast from and
+// the transform its geometry is drawn through. 256 bytes, so one of an array can be bound as a
+// uniform buffer.
+struct SampleView {
+    mat4 transform;  // world -> clip: the camera's (volumes), or the camera's * Blinn's (planar)
+    vec4 light;      // xyz: the light point; w: volumes' reach (0: to infinity, w = 0)
+    vec4 plane;      // planar: the receiver plane, n.xyz and w = -n.o
+    vec4 tolerance;  // planar: x = how far off the plane a surface may be and still be on it
+    vec4 normal;     // xyz the light sphere's normal at the point (0: a point light), w its weight
+    vec4 pad[8];
+};
+
 #endif

@@ -13,9 +13,12 @@ layout(location = 2) out vec3 out_world;
 
 void main() {
     ObjectData object = objects[gl_InstanceIndex];
-    vec4 world = object.model * vec4(in_position, 1.0);
+    // precise: shadow volumes draw light caps through this very transform
+    // (glsl/shadow_volume/volume.vert) and need the bit-identical depth.
+    precise vec4 world = object.model * vec4(in_position, 1.0);
     out_normal = mat3(object.normal_matrix) * in_normal;
     out_albedo = object.albedo;
     out_world = world.xyz;
-    gl_Position = frame.view_proj * world;
+    precise vec4 position = frame.view_proj * world;
+    gl_Position = position;
 }

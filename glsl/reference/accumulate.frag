@@ -6,6 +6,7 @@
 #include "interface.glsl"
 #include "camera.glsl"
 #include "shadow.glsl"
+#include "light_samples.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { LightSample samples[]; };
@@ -22,18 +23,9 @@ void main() {
     if (!s.receives) {
         return; // the resolve writes V = 1 where nothing was summed
     }
-    vec3 center = frame.light.xyz;
-    // Weights relative to the centre's distance: the same numbers at any scene scale.
-    float d2_center = dot(s.p - center, s.p - center);
     for (int i = 0; i < samples.length(); i++) {
         vec3 q = samples[i].position.xyz;
-        vec4 normal = samples[i].normal; // from the CPU: q - center may round to nothing here
-        float weight = 1.0; // a point light: its one sample is the centre
-        if (normal.xyz != vec3(0.0)) {
-            vec3 to_p = s.p - q;
-            float d2 = dot(to_p, to_p);
-            weight = max(dot(normal.xyz, to_p) * inversesqrt(d2), 0.0) * (d2_center / d2) * normal.w;
-        }
+        float weight = light_sample_weight(frame.light.xyz, samples[i].normal, q, s.p);
         if (weight == 0.0) {
             continue;
         }

@@ -76,9 +76,23 @@ pub struct SilhouetteParams {
     pub pad: [Vec4; 10],
 }
 
+/// One hard shadow of an accumulation, padded to 256 bytes (see `LightSample`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SampleView {
+    pub transform: Mat4,
+    pub light: Vec4,
+    pub plane: Vec4,
+    pub tolerance: Vec4,
+    /// The light sphere's normal at the point and its importance weight (`LightSample::normal`).
+    pub normal: Vec4,
+    pub pad: [Vec4; 8],
+}
+
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
 const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
 const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);
+const _: () = assert!(std::mem::size_of::<SampleView>() == 256);

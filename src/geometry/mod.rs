@@ -1,5 +1,5 @@
-//! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting and light
-//! sampling.
+//! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting, light
+//! sampling and shadow volumes.
 
 pub mod adjacency;
 mod bounds;
@@ -8,6 +8,7 @@ mod light_frustum;
 mod light_samples;
 pub mod plateau;
 mod projection;
+pub mod shadow_volume;
 pub mod shapes;
 pub mod silhouette;
 pub mod smoothie;

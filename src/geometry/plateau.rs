@@ -59,16 +59,6 @@ impl ReceiverPlane {
     /// point p ↦ (u·w, v·w, 0, w) with w = h(light) − h(p), so that points at or above the light
     /// get w ≤ 0 and the GPU's clipper removes them instead of drawing an anti-shadow.
     pub fn shadow_matrix(&self, light: Vec3) -> Mat4 {
-        let hl = self.height(light);
-        let n = self.normal;
-        // q·w = hl·p − h(p)·l, with h(p) = n·p − n·o, and w = hl − h(p).
-        let no = n.dot(self.origin);
-        let blinn = Mat4::from_cols(
-            (Vec3::X * hl - light * n.x).extend(-n.x),
-            (Vec3::Y * hl - light * n.y).extend(-n.y),
-            (Vec3::Z * hl - light * n.z).extend(-n.z),
-            (light * no).extend(hl + no),
-        );
         // Plane coordinates of the homogeneous point: (q − o·w)·u, (q − o·w)·v, 0, w.
         let to_plane = Mat4::from_cols(
             Vec4::new(self.u.x, self.v.x, 0.0, 0.0),
@@ -76,7 +66,22 @@ impl ReceiverPlane {
             Vec4::new(self.u.z, self.v.z, 0.0, 0.0),
             Vec4::new(-self.origin.dot(self.u), -self.origin.dot(self.v), 0.0, 1.0),
         );
-        to_plane * blinn
+        to_plane * self.blinn_matrix(light)
+    }
+
+    /// Blinn's projection in world space (DDJ Example 1, Komura's ground-plane matrix): p ↦
+    /// (q·w, w), q the point of the plane on the ray from `light` through p, w = h(light) − h(p).
+    pub fn blinn_matrix(&self, light: Vec3) -> Mat4 {
+        let hl = self.height(light);
+        let n = self.normal;
+        // q·w = hl·p − h(p)·l, with h(p) = n·p − n·o, and w = hl − h(p).
+        let no = n.dot(self.origin);
+        Mat4::from_cols(
+            (Vec3::X * hl - light * n.x).extend(-n.x),
+            (Vec3::Y * hl - light * n.y).extend(-n.y),
+            (Vec3::Z * hl - light * n.z).extend(-n.z),
+            (light * no).extend(hl + no),
+        )
     }
 }
 

@@ -11,8 +11,8 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::debug::{VALIDATION_LAYER, ValidationLog, messenger_info};
 use super::device::{
-    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_device_extensions,
-    required_vulkan13_features,
+    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_core_features,
+    required_device_extensions, required_vulkan13_features,
 };
 use crate::error::{Error, Result, VkContext};
 
@@ -73,6 +73,9 @@ pub struct EmbedderHandles {
     pub queue_index: u32,
     /// The Vulkan 1.3 features passed to `vkCreateDevice` (Vulkan cannot be asked afterwards).
     pub enabled_features: vk::PhysicalDeviceVulkan13Features<'static>,
+    /// The Vulkan 1.0 features passed to `vkCreateDevice`, at least
+    /// [`required_core_features`](super::required_core_features).
+    pub enabled_core_features: vk::PhysicalDeviceFeatures,
 }
 
 /// The Vulkan plumbing every pass uses, on a device of its own or the embedder's; destroyed last.
@@ -194,9 +197,11 @@ impl Context {
         let device_ext: Vec<_> =
             required_device_extensions().iter().chain(filter.device_extensions).map(|e| e.as_ptr()).collect();
         let mut v13 = required_vulkan13_features();
+        let core = required_core_features();
         let device_ci = vk::DeviceCreateInfo::default()
             .queue_create_infos(&queue_ci)
             .enabled_extension_names(&device_ext)
+            .enabled_features(&core)
             .push_next(&mut v13);
         let device = unsafe { instance.create_device(picked.physical, &device_ci, None) }.vk("vkCreateDevice")?;
         Context::assemble(Parts {
@@ -222,10 +227,24 @@ impl Context {
     /// The handles must be valid, belong together, and outlive the context; the embedder must not
     /// use the queue from another thread while the context submits to it or waits on it.
     pub unsafe fn from_handles(handles: EmbedderHandles) -> Result<Self> {
-        let EmbedderHandles { entry, instance, physical_device, device, queue_family, queue_index, enabled_features } =
-            handles;
-        let depth_stencil_format =
-            check_embedder_device(&instance, physical_device, &device, queue_family, &enabled_features)?;
+        let EmbedderHandles {
+            entry,
+            instance,
+            physical_device,
+            device,
+            queue_family,
+            queue_index,
+            enabled_features,
+            enabled_core_features,
+        } = handles;
+        let depth_stencil_format = check_embedder_device(
+            &instance,
+            physical_device,
+            &device,
+            queue_family,
+            &enabled_features,
+            &enabled_core_features,
+        )?;
         // Object names need the embedder's instance to have enabled debug utils.
         let debug_utils = unsafe {
             (instance.fp_v1_0().get_device_proc_addr)(device.handle(), c"vkSetDebugUtilsObjectNameEXT".as_ptr())

@@ -25,6 +25,12 @@ const VULKAN13_FEATURES: [(&str, Feature13); 3] = [
     ("maintenance4", |f| &mut f.maintenance4),
 ];
 
+type Feature10 = fn(&mut vk::PhysicalDeviceFeatures) -> &mut vk::Bool32;
+
+/// The Vulkan 1.0 features every context needs. depthClamp: shadow volumes extruded to
+/// infinity are kept whole instead of being cut by the far (and near) planes.
+const CORE_FEATURES: [(&str, Feature10); 1] = [("depthClamp", |f| &mut f.depth_clamp)];
+
 /// Depth-stencil formats in order of preference; Vulkan guarantees one of them.
 const DEPTH_STENCIL_FORMATS: [vk::Format; 2] = [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT];
 
@@ -38,6 +44,16 @@ pub fn required_device_extensions() -> &'static [&'static CStr] {
 pub fn required_vulkan13_features() -> vk::PhysicalDeviceVulkan13Features<'static> {
     let mut features = vk::PhysicalDeviceVulkan13Features::default();
     for (_, field) in VULKAN13_FEATURES {
+        *field(&mut features) = vk::TRUE;
+    }
+    features
+}
+
+/// The Vulkan 1.0 features a device must have enabled to run the engine
+/// (`VkDeviceCreateInfo::pEnabledFeatures`).
+pub fn required_core_features() -> vk::PhysicalDeviceFeatures {
+    let mut features = vk::PhysicalDeviceFeatures::default();
+    for (_, field) in CORE_FEATURES {
         *field(&mut features) = vk::TRUE;
     }
     features
@@ -153,6 +169,7 @@ pub(super) fn check_embedder_device(
     device: &ash::Device,
     queue_family: u32,
     enabled: &vk::PhysicalDeviceVulkan13Features,
+    enabled_core: &vk::PhysicalDeviceFeatures,
 ) -> Result<vk::Format> {
     let props = unsafe { instance.get_physical_device_properties(physical) };
     let invalid = |why: String| Error::Invalid(format!("the embedder's device {}: {why}", name_of(&props)));
@@ -163,6 +180,10 @@ pub(super) fn check_embedder_device(
     let not_enabled = missing_features(enabled);
     if !not_enabled.is_empty() {
         return Err(invalid(format!("was created without the Vulkan 1.3 features {}", not_enabled.join(", "))));
+    }
+    let not_enabled = missing_core_features(enabled_core);
+    if !not_enabled.is_empty() {
+        return Err(invalid(format!("was created without the features {}", not_enabled.join(", "))));
     }
     let missing: Vec<_> = DEVICE_EXTENSIONS
         .iter()
@@ -202,12 +223,20 @@ fn missing_features(have: &vk::PhysicalDeviceVulkan13Features) -> Vec<&'static s
     VULKAN13_FEATURES.iter().filter(|(_, field)| *field(&mut have) != vk::TRUE).map(|(name, _)| *name).collect()
 }
 
+/// Names of the required Vulkan 1.0 features that `have` lacks.
+fn missing_core_features(have: &vk::PhysicalDeviceFeatures) -> Vec<&'static str> {
+    let mut have = *have;
+    CORE_FEATURES.iter().filter(|(_, field)| *field(&mut have) != vk::TRUE).map(|(name, _)| *name).collect()
+}
+
 fn features_supported(instance: &ash::Instance, physical: vk::PhysicalDevice) -> std::result::Result<(), String> {
     let mut v13 = vk::PhysicalDeviceVulkan13Features::default();
     let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut v13);
     unsafe { instance.get_physical_device_features2(physical, &mut features) };
-    let missing = missing_features(&v13);
-    if missing.is_empty() { Ok(()) } else { Err(format!("lacks the Vulkan 1.3 features {}", missing.join(", "))) }
+    let core = features.features;
+    let mut missing = missing_features(&v13);
+    missing.extend(missing_core_features(&core));
+    if missing.is_empty() { Ok(()) } else { Err(format!("lacks the features {}", missing.join(", "))) }
 }
 
 fn has_command(instance: &ash::Instance, device: &ash::Device, name: &CStr) -> bool {
@@ -251,5 +280,7 @@ mod tests {
         assert!(missing_features(&required_vulkan13_features()).is_empty());
         let without = required_vulkan13_features().synchronization2(false);
         assert_eq!(missing_features(&without), ["synchronization2"]);
+        assert!(missing_core_features(&required_core_features()).is_empty());
+        assert_eq!(missing_core_features(&vk::PhysicalDeviceFeatures::default()), ["depthClamp"]);
     }
 }

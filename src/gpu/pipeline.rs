@@ -96,6 +96,9 @@ pub struct PipelineDesc<'a> {
     /// Two-sided by default: plates and open meshes have no inside to cull.
     pub cull: vk::CullModeFlags,
     pub color_write: vk::ColorComponentFlags,
+    /// Depth clamped to the viewport's range instead of clipping at the near and far planes
+    /// (shadow volumes reaching infinity).
+    pub depth_clamp: bool,
     /// Applied to every color target.
     pub blend: Blend,
     /// Specialization constants by the name the shaders give them.
@@ -114,6 +117,7 @@ impl<'a> PipelineDesc<'a> {
             stencil: None,
             cull: vk::CullModeFlags::NONE,
             color_write: vk::ColorComponentFlags::RGBA,
+            depth_clamp: false,
             blend: Blend::None,
             constants: &[],
         }
@@ -145,6 +149,10 @@ impl<'a> PipelineDesc<'a> {
 
     pub fn blend(self, blend: Blend) -> Self {
         PipelineDesc { blend, ..self }
+    }
+
+    pub fn depth_clamp(self) -> Self {
+        PipelineDesc { depth_clamp: true, ..self }
     }
 
     pub fn constants(self, constants: &'a [(&'static str, u32)]) -> Self {
@@ -372,6 +380,7 @@ impl Pipeline {
             vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
         let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let raster = vk::PipelineRasterizationStateCreateInfo::default()
+            .depth_clamp_enable(desc.depth_clamp)
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(desc.cull)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)

@@ -1,12 +1,15 @@
 //! Techniques: each owns its targets, pipelines and passes, and writes the visibility image V.
 //! A technique builds only what the scene in front of it needs.
 
+mod accumulation;
 mod falloff;
 pub mod knobs;
+pub mod planar;
 pub mod plateau;
 pub mod reference;
 pub mod registry;
 pub mod shadow_map;
+pub mod shadow_volume;
 pub mod smoothie;
 mod smoothie_gpu;
 pub mod traced;
@@ -28,6 +31,8 @@ pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &shadow_map::PCSS,
     &plateau::INFO,
     &smoothie::INFO,
+    &shadow_volume::INFO,
+    &planar::INFO,
     &reference::INFO,
     &traced::RAYTRACE,
     &traced::PARKER,

@@ -78,6 +78,18 @@ pub struct TechniqueInfo {
     pub bench: &'static [Setting],
     pub sweep_knobs: SweepKnobs,
     pub cost_goal: Option<CostGoal>,
+    pub receivers: Receivers,
+}
+
+/// Which surfaces a technique can shadow: a stated limit of the method, which the accuracy
+/// checks respect (they compare a plane-only technique with a truth in which only the ground
+/// receives).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Receivers {
+    /// Every receiver in view.
+    All,
+    /// The ground plane only (the planar family: Blinn's projection onto one plane).
+    GroundPlane,
 }
 
 impl TechniqueInfo {

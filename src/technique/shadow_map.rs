@@ -14,7 +14,7 @@ use bytemuck::bytes_of;
 use glam::Vec4;
 
 use super::knobs::{Knob, Params};
-use super::registry::{Kind, SweepKnobs, TechniqueInfo};
+use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::LightView;
@@ -34,6 +34,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     bench: &[&[], &[("shadow_map_size", "1024")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
+    receivers: Receivers::All,
 };
 
 /// Percentage-closer filtering (Reeves, Salesin & Cook 1987) on the same map.
@@ -46,6 +47,7 @@ pub const PCF: TechniqueInfo = TechniqueInfo {
     bench: &[&[("taps", "16")], &[("taps", "4")], &[("taps", "32")], &[("bicubic", "1")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
+    receivers: Receivers::All,
 };
 
 /// Percentage-closer soft shadows (Fernando 2005) on the same map.
@@ -58,6 +60,7 @@ pub const PCSS: TechniqueInfo = TechniqueInfo {
     bench: &[&[], &[("blocker_samples", "32"), ("filter_samples", "32")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
+    receivers: Receivers::All,
 };
 
 const TAPS: Knob =

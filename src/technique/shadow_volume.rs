@@ -1,0 +1,390 @@
+//! `shadow-volume`: stencil shadow volumes (Crow 1977; DDJ 2005 "shadow volumes"; Komura
+//! "shadow volume"): exact hard shadows from a point, soft by accumulating N of them.
+//!
+//! Per light point, in the papers' order: `silhouettes` (on the CPU, the shared silhouette
+//! code, cached while nothing moves), `volumes` (the silhouette edges extruded to infinity,
+//! w = 0, counted by two-sided stencil in one pass), `caps` (z-fail only: the light caps, the
+//! caster's light-facing triangles, and the dark caps at infinity), then the stencil resolved
+//! into V: 0 is lit, anything else shadowed ([`Accumulation`]), and `resolve`.
+//!
+//! Reach. Perspective views extrude to infinity (w = 0); orthographic ones, where points at
+//! infinity along the view axis collapse into one and the dark caps would vanish, extrude far
+//! past every receiver instead ([`FINITE_REACH`]).
+//!
+//! Depth. The volumes test against the camera prepass's depth, copied bit for bit into a
+//! depth-stencil target of our own (`glsl/shadow_volume/depth.frag`): one full-screen pass,
+//! cheaper than drawing the scene again, and exactly the surfaces V is reported at. Depth
+//! clamping (the device's `depthClamp`) keeps volumes whole past the far plane and in front of
+//! the near one, so no volume is ever too short or too long, with the camera's own fitted
+//! projection, perspective or orthographic (an infinite far plane would serve only the first).
+//!
+//! Counting. z-pass (front faces in front of the surface add, back faces subtract) is wrong
+//! where a view ray starts inside a volume; z-fail (Carmack's reverse: count what lies behind,
+//! with both caps) is not. With depth clamping the near plane cuts nothing, so what remains is
+//! the view rays' start, the eye: the engine picks z-fail exactly when the eye can lie in a
+//! caster's shadow (orthographic rays start infinitely far behind, outside every volume),
+//! `counting` forces either. Deviation from the papers' "near plane" test: with the near plane
+//! unclipped it is the eye, not the near plane, that matters. No depth
+//! bias anywhere: self-shadowing comes from the counts alone (light caps have the surface's
+//! depth to the bit, `glsl/shadow_volume/volume.vert`).
+//!
+//! Counts beyond the stencil's bits: volumes are counted modulo 128 in the low 7 bits, casters
+//! taken in groups whose nesting bounds (`nesting_bound`) sum to at most 127, and each group's
+//! non-zero pixels marked in the top bit before the next group counts. One caster alone that
+//! could nest more than 127 times in itself is the one case left to the modulo.
+
+use ash::vk;
+use bytemuck::cast_slice;
+use glam::{Mat4, Vec3, Vec4};
+
+use super::accumulation::{Accumulation, SAMPLES, StencilRule, end_span, span, stencil};
+use super::knobs::{Knob, Params};
+use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::{Technique, clear_visibility};
+use crate::error::Result;
+use crate::frame::FrameInputs;
+use crate::frame::interface::SampleView;
+use crate::geometry::shadow_volume::{ShadowVolume, eye_may_be_in_shadow, is_open, nesting_bound, shadow_volume};
+use crate::geometry::silhouette::{Caster, light_facing};
+use crate::geometry::{Aabb, Projection};
+use crate::gpu::{
+    Access, Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
+    TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
+};
+use crate::scene::MeshId;
+
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "shadow-volume",
+    summary: "stencil shadow volumes: silhouettes extruded to infinity, z-pass or z-fail; N accumulated for soft",
+    kind: Kind::Realtime,
+    knobs: &[SAMPLES, COUNTING],
+    create: |ctx, _, visibility| Ok(Box::new(ShadowVolumes::new(ctx, visibility)?)),
+    bench: &[&[], &[("counting", "2")], &[("samples", "16")]],
+    sweep_knobs: SweepKnobs::DEFAULTS,
+    cost_goal: None,
+    receivers: Receivers::All,
+};
+
+const COUNTING: Knob = Knob {
+    name: "counting",
+    default: 0.0,
+    min: 0.0,
+    max: 2.0,
+    integer: true,
+    help: "0: z-fail where a view ray can start in shadow, else z-pass; 1: z-pass; 2: z-fail",
+};
+
+/// The stencil bits that count; the top one marks the pixels an earlier group shadowed.
+const COUNT_MASK: u32 = 0x7F;
+const SHADOWED_BY_A_GROUP: u32 = 0x80;
+/// Floats per volume vertex: object-space position, at infinity (0 or 1), object index.
+const VERTEX_FLOATS: usize = 5;
+/// Orthographic views: how far volumes reach, in multiples of the farthest scene point's
+/// distance from the light (a dark cap's chord stays beyond the scene up to 170° of caster).
+const FINITE_REACH: f32 = 1e3;
+
+/// What a caster's volumes were built from: rebuilt only when any of it changes.
+#[derive(Clone, Debug, PartialEq)]
+struct VolumeKey {
+    mesh: MeshId,
+    model: Mat4,
+    points: Vec<Vec3>,
+}
+
+/// One group's vertex ranges in this frame's volume buffer.
+#[derive(Clone, Copy, Debug, Default)]
+struct GroupRange {
+    first: u32,
+    sides: u32,
+    caps: u32,
+    turned: u32,
+}
+
+pub struct ShadowVolumes {
+    depth_copy: Pipeline,
+    /// Counting pipelines: z-pass, z-fail, z-fail for the turned light caps.
+    zpass: Pipeline,
+    zfail: Pipeline,
+    zfail_turned: Pipeline,
+    mark: Pipeline,
+    accumulation: Accumulation,
+    format: vk::Format,
+    vertices: Option<PerFrame>,
+    depth_stencil: Option<Target>,
+    /// Per scene object: its volumes, one per light point, and what they were built from.
+    volumes: Vec<Option<(VolumeKey, Vec<ShadowVolume>)>>,
+    bounds: Vec<(MeshId, u32)>,
+}
+
+impl ShadowVolumes {
+    pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
+        let format = ctx.depth_stencil_format();
+        let vert = &shaders::SHADOW_VOLUME_VOLUME_VERT;
+        let frag = &shaders::SHADOW_VOLUME_STENCIL_FRAG;
+        let fullscreen = &shaders::COMMON_FULLSCREEN_VERT;
+        let masks = (0xFF, COUNT_MASK);
+        let (keep, up, down) =
+            (vk::StencilOp::KEEP, vk::StencilOp::INCREMENT_AND_WRAP, vk::StencilOp::DECREMENT_AND_WRAP);
+        let always = vk::CompareOp::ALWAYS;
+        let counting = |name, front: vk::StencilOpState, back: vk::StencilOpState| {
+            let desc = PipelineDesc::new(name, vert, frag)
+                .vertex_input(VertexInput::Floats(&[3, 1, 1]))
+                // Reverse Z: in front of the surface is greater.
+                .depth(DepthState::test_only(format, vk::CompareOp::GREATER))
+                .depth_clamp()
+                .stencil(front, back);
+            Pipeline::new(ctx, &desc)
+        };
+        // z-pass: what passes the depth test counts; z-fail: what fails it, with signs swapped.
+        let zpass = Guard::new(
+            ctx,
+            counting("volumes", stencil(always, 0, masks, up, keep), stencil(always, 0, masks, down, keep))?,
+        );
+        let zfail_front = stencil(always, 0, masks, keep, down);
+        let zfail_back = stencil(always, 0, masks, keep, up);
+        let zfail = Guard::new(ctx, counting("volumes", zfail_front, zfail_back)?);
+        let zfail_turned = Guard::new(ctx, counting("caps", zfail_back, zfail_front)?);
+        let marked = stencil(vk::CompareOp::NOT_EQUAL, 0, (COUNT_MASK, 0xFF), vk::StencilOp::REPLACE, keep);
+        let marked = vk::StencilOpState { reference: SHADOWED_BY_A_GROUP, ..marked };
+        let mark = PipelineDesc::new("mark", fullscreen, frag)
+            .depth(DepthState::test_only(format, always))
+            .stencil(marked, marked);
+        let mark = Guard::new(ctx, Pipeline::new(ctx, &mark)?);
+        let copy = PipelineDesc::new("depth", fullscreen, &shaders::SHADOW_VOLUME_DEPTH_FRAG)
+            .depth(DepthState::test_write(format, always));
+        let depth_copy = Guard::new(ctx, Pipeline::new(ctx, &copy)?);
+        let rule = StencilRule {
+            lit: (vk::CompareOp::EQUAL, 0),
+            shadowed: (vk::CompareOp::NOT_EQUAL, 0, vk::StencilOp::ZERO),
+        };
+        let accumulation = Accumulation::new(ctx, format, visibility, rule)?;
+        Ok(ShadowVolumes {
+            depth_copy: depth_copy.keep(),
+            zpass: zpass.keep(),
+            zfail: zfail.keep(),
+            zfail_turned: zfail_turned.keep(),
+            mark: mark.keep(),
+            accumulation,
+            format,
+            vertices: None,
+            depth_stencil: None,
+            volumes: Vec::new(),
+            bounds: Vec::new(),
+        })
+    }
+
+    /// Every caster's volumes from every point, rebuilt only for casters or lights that moved.
+    fn build(&mut self, frame: &FrameInputs<'_>, points: &[Vec3]) {
+        let objects = &frame.scene.objects;
+        self.volumes.resize_with(objects.len(), || None);
+        for (o, cached) in objects.iter().zip(&mut self.volumes) {
+            if !o.casts {
+                *cached = None;
+                continue;
+            }
+            let model = o.transform.matrix();
+            let key = VolumeKey { mesh: o.mesh.id(), model, points: points.to_vec() };
+            if cached.as_ref().is_some_and(|(k, _)| *k == key) {
+                continue;
+            }
+            let positions: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
+            let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
+            let two_sided = is_open(&caster);
+            if !self.bounds.iter().any(|(id, _)| *id == o.mesh.id()) {
+                self.bounds.push((o.mesh.id(), nesting_bound(&caster, two_sided)));
+            }
+            let volumes =
+                points.iter().map(|q| shadow_volume(&caster, &light_facing(&caster, *q), two_sided)).collect();
+            *cached = Some((key, volumes));
+        }
+    }
+
+    /// Casters in groups whose nesting bounds sum to at most [`COUNT_MASK`].
+    fn groups(&self, frame: &FrameInputs<'_>) -> Vec<Vec<usize>> {
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut room = 0;
+        for (i, o) in frame.scene.objects.iter().enumerate().filter(|(_, o)| o.casts) {
+            let bound = self.bounds.iter().find(|(id, _)| *id == o.mesh.id()).map_or(COUNT_MASK, |b| b.1);
+            let bound = bound.min(COUNT_MASK);
+            if groups.is_empty() || bound > room {
+                groups.push(Vec::new());
+                room = COUNT_MASK;
+            }
+            groups.last_mut().expect("pushed").push(i);
+            room -= bound;
+        }
+        groups
+    }
+
+    /// The volume vertices of every point and group, and each one's ranges.
+    fn vertices(&self, frame: &FrameInputs<'_>, points: usize, groups: &[Vec<usize>]) -> (Vec<f32>, Vec<GroupRange>) {
+        let mut out = Vec::new();
+        let mut ranges = Vec::with_capacity(points * groups.len());
+        for p in 0..points {
+            for group in groups {
+                let first = (out.len() / VERTEX_FLOATS) as u32;
+                let mut counts = [0u32; 3];
+                for (part, count) in counts.iter_mut().enumerate() {
+                    let start = out.len();
+                    for &i in group {
+                        let mesh = &frame.scene.objects[i].mesh;
+                        let object = frame.draws[i].instance as f32;
+                        let volume = &self.volumes[i].as_ref().expect("built for every caster").1[p];
+                        let mut put = |vertex: u32, far: bool| {
+                            let q = mesh.positions[vertex as usize];
+                            out.extend_from_slice(&[q.x, q.y, q.z, far as u32 as f32, object]);
+                        };
+                        match part {
+                            0 => volume.sides.iter().flatten().for_each(|c| put(c.vertex, c.at_infinity)),
+                            1 => {
+                                volume.far_caps.iter().flatten().for_each(|c| put(c.vertex, c.at_infinity));
+                                volume.near_caps.iter().flatten().for_each(|&v| put(v, false));
+                            }
+                            _ => volume.turned_caps.iter().flatten().for_each(|&v| put(v, false)),
+                        }
+                    }
+                    *count = ((out.len() - start) / VERTEX_FLOATS) as u32;
+                }
+                ranges.push(GroupRange { first, sides: counts[0], caps: counts[1], turned: counts[2] });
+            }
+        }
+        (out, ranges)
+    }
+
+    /// How far volumes reach past their caster: `None`, to infinity (w = 0), for a perspective
+    /// camera. An orthographic one sees points at infinity along its axis as one point, so its
+    /// dark caps would vanish; there the volumes end [`FINITE_REACH`] scene sizes out, far
+    /// beyond every receiver, and, depth clamping keeping what lies behind the camera, every
+    /// view ray starts outside them: z-pass is exact.
+    fn extrusion(frame: &FrameInputs<'_>, points: &[Vec3]) -> Option<f32> {
+        let Projection::Orthographic { .. } = frame.scene.camera.projection else { return None };
+        let scene = frame.draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
+        let far = points.iter().flat_map(|q| scene.corners().map(|c| (c - *q).length())).fold(0.0, f32::max);
+        Some(FINITE_REACH * far)
+    }
+
+    /// Whether this frame counts by z-fail.
+    fn z_fail(frame: &FrameInputs<'_>, params: &Params, points: &[Vec3]) -> bool {
+        match params.get(&COUNTING) as u32 {
+            1 => false,
+            2 => true,
+            _ if Self::extrusion(frame, points).is_some() => false,
+            _ => {
+                let casters: Vec<_> = frame.draws.iter().filter(|d| d.casts).map(|d| d.bounds).collect();
+                points.iter().any(|q| eye_may_be_in_shadow(*q, frame.camera.position, &casters))
+            }
+        }
+    }
+}
+
+impl Technique for ShadowVolumes {
+    fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()> {
+        if !frame.draws.iter().any(|d| d.casts) || frame.receivers_in_view.is_empty() {
+            return clear_visibility(frame, visibility);
+        }
+        let ctx = frame.ctx;
+        let samples = Accumulation::points(frame, params.get(&SAMPLES) as usize);
+        let points: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
+        let z_fail = Self::z_fail(frame, params, &points);
+        let reach = Self::extrusion(frame, &points).unwrap_or(0.0);
+        self.build(frame, &points);
+        let groups = self.groups(frame);
+        let (vertices, ranges) = self.vertices(frame, points.len(), &groups);
+        if !vertices.is_empty() {
+            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+            let bytes: &[u8] = cast_slice(&vertices);
+            PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
+                .write(frame.slot, bytes);
+        }
+        let views: Vec<SampleView> = samples
+            .iter()
+            .map(|s| (s.position, s.normal.extend(s.weight)))
+            .map(|(q, normal)| SampleView {
+                transform: frame.camera.view_proj,
+                light: q.extend(reach),
+                plane: Vec4::ZERO,
+                tolerance: Vec4::ZERO,
+                normal,
+                pad: [Vec4::ZERO; 8],
+            })
+            .collect();
+        let extent = visibility.extent();
+        self.accumulation.prepare(frame, &views, extent)?;
+        let desc = TargetDesc::depth_stencil("shadow volume stencil", self.format, extent.width, extent.height);
+        ensure(ctx, &mut self.depth_stencil, desc)?;
+        let ds = self.depth_stencil.as_mut().expect("ensured");
+        let cmd = frame.cmd;
+        let timed = points.len() == 1;
+        let several = groups.len() > 1;
+        // z-pass needs no caps, but for finite volumes (orthographic views) rays from behind
+        // the camera cross the dark caps; light caps in front of a surface would hide it, so
+        // drawing them as well changes nothing.
+        let caps = z_fail || reach > 0.0;
+        span(frame, !timed, "accumulate");
+        for (p, point_ranges) in ranges.chunks(groups.len()).enumerate() {
+            let view = Descriptor::Buffer(self.accumulation.view(frame.slot, p));
+            let inputs = [Descriptor::Buffer(frame.globals), view, Descriptor::Buffer(frame.objects)];
+            for (g, range) in point_ranges.iter().enumerate() {
+                let first = p == 0 && g == 0;
+                span(frame, timed, "volumes");
+                transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, first)]);
+                let attachment = if first {
+                    Attachment::clear_depth_stencil(ds, 0.0, 0)
+                } else {
+                    Attachment { target: ds, clear: None }
+                };
+                let pass = RenderPass::begin(ctx, cmd, &[], Some(attachment));
+                if first {
+                    self.depth_copy.bind(ctx, cmd, &[Descriptor::Image(frame.depth)])?;
+                    draw_fullscreen(ctx, cmd);
+                }
+                let vb = self.vertices.as_ref().map(|v| v.range(frame.slot));
+                let counting = if z_fail { &self.zfail } else { &self.zpass };
+                counting.bind(ctx, cmd, &inputs)?;
+                if let Some(vb) = vb {
+                    draw_vertices(ctx, cmd, vb, range.first, range.sides);
+                }
+                if several && !caps {
+                    self.mark.bind(ctx, cmd, &[])?;
+                    draw_fullscreen(ctx, cmd);
+                }
+                pass.end(ctx, cmd);
+                end_span(frame, timed);
+                if caps {
+                    span(frame, timed, "caps");
+                    transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, false)]);
+                    let pass = RenderPass::begin(ctx, cmd, &[], Some(Attachment { target: ds, clear: None }));
+                    if let Some(vb) = vb {
+                        counting.bind(ctx, cmd, &inputs)?;
+                        draw_vertices(ctx, cmd, vb, range.first + range.sides, range.caps);
+                        if z_fail {
+                            self.zfail_turned.bind(ctx, cmd, &inputs)?;
+                            draw_vertices(ctx, cmd, vb, range.first + range.sides + range.caps, range.turned);
+                        }
+                    }
+                    if several {
+                        self.mark.bind(ctx, cmd, &[])?;
+                        draw_fullscreen(ctx, cmd);
+                    }
+                    pass.end(ctx, cmd);
+                    end_span(frame, timed);
+                }
+            }
+            span(frame, timed, "accumulate");
+            self.accumulation.add(frame, ds, p)?;
+            end_span(frame, timed);
+        }
+        end_span(frame, !timed);
+        self.accumulation.resolve(frame, visibility)
+    }
+
+    fn destroy(self: Box<Self>, ctx: &Context) {
+        let this = *self;
+        for p in [this.depth_copy, this.zpass, this.zfail, this.zfail_turned, this.mark] {
+            p.destroy(ctx);
+        }
+        this.accumulation.destroy(ctx);
+        this.vertices.into_iter().for_each(|b| b.destroy(ctx));
+        this.depth_stencil.into_iter().for_each(|t| t.destroy(ctx));
+    }
+}
