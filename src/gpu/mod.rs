@@ -1,5 +1,5 @@
 //! The only Vulkan plumbing: context (own or the embedder's handles), memory, targets (own or
-//! wrapped), barriers, pipelines, shaders, timestamps, frames and readback. Nothing here knows
+//! wrapped), barriers, pipelines, shaders, timestamps, frames, readback and the swapchain. Nothing here knows
 //! about shadows.
 
 mod barrier;
@@ -13,6 +13,7 @@ mod pipeline;
 pub mod reflect;
 mod render;
 pub mod shaders;
+mod swapchain;
 mod target;
 mod timestamps;
 mod upload;
@@ -29,6 +30,7 @@ pub use render::{
     Attachment, RenderPass, dispatch, draw_fullscreen, draw_indexed, draw_indirect, draw_vertices, fullscreen,
     update_buffer,
 };
+pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{copy_to_buffer, copy_to_target, upload};
