@@ -37,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut frame: u64 = 0;
     'game: loop {
         // Input: everything the window reported since the last frame, without waiting.
-        let mut switch = frames.is_some_and(|n| n >= 4 && frame > 0 && frame % (n / 4) == 0);
+        let mut switch = frames.is_some_and(|n| n >= 4 && frame > 0 && frame.is_multiple_of(n / 4));
         for event in app.poll() {
             match event {
                 WindowEvent::CloseRequested => break 'game,
@@ -73,7 +73,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(last) = engine.take_timings().last() {
             gpu_ms = last.passes.iter().map(|p| p.ms).sum::<f64>();
         }
-        if frame % 30 == 0 {
+        if frame.is_multiple_of(30) {
             app.window().set_title(&format!("softshadow game loop: {} {gpu_ms:.2} GPU ms", techniques[current].name));
         }
 

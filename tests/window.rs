@@ -18,12 +18,15 @@ use winit::dpi::PhysicalSize;
 const W: u32 = 96;
 const H: u32 = 64;
 
+/// A check on the shared window.
+type Check = fn(&mut AppWindow);
+
 fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
     let _xvfb = common::xvfb::ensure_display();
     without_a_display_opening_a_window_names_the_variables();
     let mut app = AppWindow::open("softshadow window tests", W, H).expect("a window on the X server");
-    let checks: [(&str, fn(&mut AppWindow)); 4] = [
+    let checks: [(&str, Check); 4] = [
         ("a_moving_caster_is_presented_through_two_resizes", a_moving_caster_is_presented_through_two_resizes),
         ("a_presented_image_equals_the_headless_capture", a_presented_image_equals_the_headless_capture),
         ("the_present_mode_asked_for_is_taken", the_present_mode_asked_for_is_taken),
@@ -121,7 +124,8 @@ fn a_presented_image_equals_the_headless_capture(app: &mut AppWindow) {
     let s = scene(0.3);
     let params = params(&s);
     let mut headless = common::engine();
-    let truth = headless.render_and_capture(&s, &FrameSettings { width: W, height: H, params: params.clone() }).unwrap();
+    let truth =
+        headless.render_and_capture(&s, &FrameSettings { width: W, height: H, params: params.clone() }).unwrap();
     common::finish(headless);
     let lit = truth.visibility.iter().filter(|&&v| v == u16::MAX).count();
     assert!(lit > 0 && lit < truth.visibility.len(), "a scene with a shadow in view");

@@ -181,7 +181,9 @@ mod tests {
         for write in [Access::COLOR_WRITE, Access::DEPTH_WRITE, Access::DEPTH_STENCIL_WRITE, Access::COPY_WRITE] {
             assert!(is_write(write.access), "{write:?}");
         }
-        for read in [Access::NONE, Access::DEPTH_STENCIL_READ, Access::FRAGMENT_READ, Access::COPY_READ, Access::PRESENT] {
+        for read in
+            [Access::NONE, Access::DEPTH_STENCIL_READ, Access::FRAGMENT_READ, Access::COPY_READ, Access::PRESENT]
+        {
             assert!(!is_write(read.access), "{read:?}");
         }
     }

@@ -60,8 +60,11 @@ pub struct DeviceFilter<'a> {
     /// Creates the window's surface once the instance exists (it must exist before a device is
     /// picked); the chosen queue family must then also present to it. The context keeps the
     /// surface and destroys it before the instance.
-    pub surface: Option<&'a dyn Fn(&ash::Entry, &ash::Instance) -> Result<vk::SurfaceKHR>>,
+    pub surface: Option<&'a CreateSurface<'a>>,
 }
+
+/// Makes a surface on a fresh instance (see [`DeviceFilter::surface`]).
+pub type CreateSurface<'a> = dyn Fn(&ash::Entry, &ash::Instance) -> Result<vk::SurfaceKHR> + 'a;
 
 impl DeviceFilter<'static> {
     /// No extras: every graphics and compute queue family with timestamps will do.

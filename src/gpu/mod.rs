@@ -20,7 +20,7 @@ mod upload;
 
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
 pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership};
-pub use device::{DeviceFilter, required_device_extensions, required_vulkan13_features};
+pub use device::{CreateSurface, DeviceFilter, required_device_extensions, required_vulkan13_features};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing, Semaphores};
 pub use guard::{Destroy, Guard};
 pub use memory::{Buffer, PerFrame};

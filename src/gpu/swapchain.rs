@@ -188,8 +188,8 @@ impl Swapchain {
             count = count.min(caps.max_image_count);
         }
         // Readback of presented images (tests, screenshots) copies from them.
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
-            | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
+        let usage =
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
         let alpha = [
             vk::CompositeAlphaFlagsKHR::OPAQUE,
             vk::CompositeAlphaFlagsKHR::INHERIT,

@@ -16,9 +16,9 @@ use glam::{Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 
 pub use capture::{Capture, pixel_uv};
-pub use window::{AppWindow, Presented, WindowOptions, WindowStats};
 use draw::MeshCache;
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
+pub use window::{AppWindow, Presented, WindowOptions, WindowStats};
 
 use crate::error::Result;
 use crate::frame::interface::{FrameGlobals, ObjectData};

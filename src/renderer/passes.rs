@@ -113,7 +113,11 @@ impl Composite {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "composite");
         let color = into.unwrap_or(&mut t.color);
-        transition(ctx, cmd, &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (color, Access::COLOR_WRITE, true)]);
+        transition(
+            ctx,
+            cmd,
+            &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (color, Access::COLOR_WRITE, true)],
+        );
         fullscreen(
             ctx,
             cmd,
