@@ -26,11 +26,12 @@ fn main() {
     let _xvfb = common::xvfb::ensure_display();
     without_a_display_opening_a_window_names_the_variables();
     let mut app = AppWindow::open("softshadow window tests", W, H).expect("a window on the X server");
-    let checks: [(&str, Check); 4] = [
+    let checks: [(&str, Check); 5] = [
         ("a_moving_caster_is_presented_through_two_resizes", a_moving_caster_is_presented_through_two_resizes),
         ("a_presented_image_equals_the_headless_capture", a_presented_image_equals_the_headless_capture),
         ("the_present_mode_asked_for_is_taken", the_present_mode_asked_for_is_taken),
         ("fifo_keeps_the_cpu_within_the_frames_in_flight", fifo_keeps_the_cpu_within_the_frames_in_flight),
+        ("softshadow_view_presents_and_writes_a_screenshot", softshadow_view_presents_and_writes_a_screenshot),
     ];
     for (name, check) in checks {
         if filter.as_ref().is_some_and(|f| !name.contains(f.as_str())) {
@@ -183,4 +184,29 @@ fn fifo_keeps_the_cpu_within_the_frames_in_flight(app: &mut AppWindow) {
     }
     assert_eq!(most_ahead, FRAMES_IN_FLIGHT, "the CPU records while the GPU renders");
     common::finish(engine);
+}
+
+/// `softshadow view SCENE --frames N --screenshot FILE` presents N frames, writes the last one
+/// at the scene's size and exits 0; without a display it says which variables it looked at.
+fn softshadow_view_presents_and_writes_a_screenshot(_: &mut AppWindow) {
+    let scene = format!("{}/scenes/plate.toml", env!("CARGO_MANIFEST_DIR"));
+    let shot = std::env::temp_dir().join(format!("softshadow-view-{}.png", std::process::id()));
+    let run = |display: bool| {
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_softshadow"));
+        cmd.args(["view", &scene, "--frames", "5", "--screenshot"]).arg(&shot).env("SOFTSHADOW_VALIDATION", "1");
+        if !display {
+            cmd.env_remove("DISPLAY").env_remove("WAYLAND_DISPLAY");
+        }
+        cmd.output().expect("softshadow runs")
+    };
+    let out = run(true);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let image = image::open(&shot).expect("a PNG screenshot");
+    let s = Scene::load(&scene).unwrap();
+    assert_eq!((image.width(), image.height()), (s.render.width, s.render.height));
+    std::fs::remove_file(&shot).unwrap();
+    let out = run(false);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("DISPLAY") && !stderr.contains("panicked"), "{stderr}");
 }
