@@ -23,7 +23,7 @@ type Check = fn(&mut AppWindow);
 
 fn main() {
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
-    let _xvfb = common::xvfb::ensure_display();
+    let xvfb = common::xvfb::ensure_display();
     without_a_display_opening_a_window_names_the_variables();
     let mut app = AppWindow::open("softshadow window tests", W, H).expect("a window on the X server");
     let checks: [(&str, Check); 5] = [
@@ -33,13 +33,22 @@ fn main() {
         ("fifo_keeps_the_cpu_within_the_frames_in_flight", fifo_keeps_the_cpu_within_the_frames_in_flight),
         ("softshadow_view_presents_and_writes_a_screenshot", softshadow_view_presents_and_writes_a_screenshot),
     ];
-    for (name, check) in checks {
-        if filter.as_ref().is_some_and(|f| !name.contains(f.as_str())) {
-            continue;
+    // A failed check must still stop the Xvfb: catch the panic, drop everything, then fail.
+    let passed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        for (name, check) in checks {
+            if filter.as_ref().is_some_and(|f| !name.contains(f.as_str())) {
+                continue;
+            }
+            let start = Instant::now();
+            check(&mut app);
+            println!("test {name} ... ok ({:.1} s)", start.elapsed().as_secs_f64());
         }
-        let start = Instant::now();
-        check(&mut app);
-        println!("test {name} ... ok ({:.1} s)", start.elapsed().as_secs_f64());
+    }))
+    .is_ok();
+    drop(app);
+    drop(xvfb);
+    if !passed {
+        std::process::exit(1);
     }
 }
 
