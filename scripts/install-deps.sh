@@ -5,7 +5,8 @@
 # the plots of `softshadow bench`.
 set -euo pipefail
 packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers
-          libshaderc-dev glslang-dev spirv-tools pkg-config fonts-dejavu-core)
+          libshaderc-dev glslang-dev spirv-tools pkg-config fonts-dejavu-core
+          libx11-6 libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -19,6 +19,9 @@ pub enum Error {
     /// No Vulkan loader, driver or suitable device.
     #[error("{0}")]
     NoDevice(String),
+    /// No display to open a window on, or the window system refused one.
+    #[error("{0}")]
+    Window(String),
     /// A Vulkan call failed.
     #[error("Vulkan call {call} failed: {result}")]
     Vulkan { call: &'static str, result: vk::Result },

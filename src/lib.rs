@@ -29,4 +29,6 @@ pub mod scene;
 pub mod technique;
 
 pub use error::{Error, Result};
-pub use renderer::{Capture, CpuSpan, Engine, FrameSettings, FrameTimings};
+pub use renderer::{
+    AppWindow, Capture, CpuSpan, Engine, FrameSettings, FrameTimings, Presented, WindowOptions, WindowStats,
+};

@@ -1,5 +1,8 @@
 //! The `softshadow` command line (DESIGN.md §3).
 
+#[path = "softshadow/view.rs"]
+mod view;
+
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result, bail};
@@ -34,6 +37,9 @@ enum Command {
     /// the error against the CPU ray tracer, and the same table printed. `softshadow` with no
     /// arguments runs it on the default scene into out/.
     Showcase(ShowcaseArgs),
+    /// Open a window on a scene: orbit, pan and zoom with the mouse, drag the light, switch
+    /// techniques and knobs, take screenshots, measure the error against the reference.
+    View(view::ViewArgs),
     /// List the techniques and their knobs with defaults.
     Techniques,
     /// Show the Vulkan device, driver and limits.
@@ -151,6 +157,7 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Compare(args)) => compare(&args),
         Some(Command::Bench(args)) => bench(&args),
         Some(Command::Showcase(args)) => showcase(&args),
+        Some(Command::View(args)) => view::view(&args),
         Some(Command::Techniques) => {
             for t in TECHNIQUES {
                 println!("{}: {}", t.name, t.summary);

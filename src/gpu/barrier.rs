@@ -68,6 +68,14 @@ impl Access {
         access: vk::AccessFlags2::TRANSFER_WRITE,
         layout: vk::ImageLayout::TRANSFER_DST_OPTIMAL,
     };
+    /// Handed to or back from the presentation engine. The acquire semaphore is waited on, and
+    /// the present semaphore signalled, at this stage: the first and last writes of a swapchain
+    /// image are color attachment writes.
+    pub const PRESENT: Access = Access {
+        stage: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+        access: vk::AccessFlags2::NONE,
+        layout: vk::ImageLayout::PRESENT_SRC_KHR,
+    };
     /// Copied out for readback.
     pub const COPY_READ: Access = Access {
         stage: vk::PipelineStageFlags2::COPY,
@@ -173,7 +181,9 @@ mod tests {
         for write in [Access::COLOR_WRITE, Access::DEPTH_WRITE, Access::DEPTH_STENCIL_WRITE, Access::COPY_WRITE] {
             assert!(is_write(write.access), "{write:?}");
         }
-        for read in [Access::NONE, Access::DEPTH_STENCIL_READ, Access::FRAGMENT_READ, Access::COPY_READ] {
+        for read in
+            [Access::NONE, Access::DEPTH_STENCIL_READ, Access::FRAGMENT_READ, Access::COPY_READ, Access::PRESENT]
+        {
             assert!(!is_write(read.access), "{read:?}");
         }
     }

@@ -11,7 +11,7 @@ use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use super::debug::{VALIDATION_LAYER, ValidationLog, messenger_info};
 use super::device::{
-    DeviceFilter, check_embedder_device, driver_of, name_of, pick_device, required_core_features,
+    DeviceFilter, Surface, check_embedder_device, driver_of, name_of, pick_device, required_core_features,
     required_device_extensions, required_vulkan13_features,
 };
 use crate::error::{Error, Result, VkContext};
@@ -83,6 +83,8 @@ pub struct Context {
     _entry: ash::Entry,
     pub(crate) instance: ash::Instance,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// The window's surface, made by the device filter; destroyed before the instance.
+    pub(super) surface: Option<Surface>,
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
     pub(crate) physical: vk::PhysicalDevice,
     pub(crate) device: ash::Device,
@@ -101,6 +103,8 @@ pub struct Context {
     // Boxed: the messenger holds a pointer to it. Dropped after the instance.
     log: Box<ValidationLog>,
     destroyed: bool,
+    /// What the surface was made from, kept alive until the surface is destroyed.
+    pub(super) window: Option<std::sync::Arc<dyn std::any::Any + Send + Sync>>,
 }
 
 /// What a constructor hands to `assemble`: the handles, and what was learned checking the device.
@@ -108,6 +112,7 @@ struct Parts {
     entry: ash::Entry,
     instance: ash::Instance,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    surface: Option<Surface>,
     debug_utils: bool,
     physical: vk::PhysicalDevice,
     device: ash::Device,
@@ -180,7 +185,7 @@ impl Context {
             result => Error::Vulkan { call: "vkCreateInstance", result },
         })?;
         // Until the context exists, failures must destroy what does: build the rest in a guard.
-        let mut guard = InstanceGuard { instance: Some(instance), messenger: None };
+        let mut guard = InstanceGuard { instance: Some(instance), messenger: None, surface: None };
         let instance = guard.instance.as_ref().expect("just created");
         if options.validation {
             let loader = ash::ext::debug_utils::Instance::new(&entry, instance);
@@ -189,7 +194,10 @@ impl Context {
             guard.messenger = Some((loader, messenger));
         }
 
-        let picked = pick_device(instance, options.device.as_deref(), filter)?;
+        if let Some(create) = filter.surface {
+            guard.surface = Some((ash::khr::surface::Instance::new(&entry, instance), create(&entry, instance)?));
+        }
+        let picked = pick_device(instance, options.device.as_deref(), filter, guard.surface.as_ref())?;
         let priorities = [1.0];
         let queue_ci = [vk::DeviceQueueCreateInfo::default()
             .queue_family_index(picked.queue_family)
@@ -208,6 +216,7 @@ impl Context {
             entry,
             instance: guard.instance.take().expect("guarded instance"),
             messenger: guard.messenger.take(),
+            surface: guard.surface.take(),
             debug_utils,
             physical: picked.physical,
             device,
@@ -254,6 +263,7 @@ impl Context {
             entry,
             instance,
             messenger: None,
+            surface: None,
             debug_utils,
             physical: physical_device,
             device,
@@ -268,7 +278,7 @@ impl Context {
     /// The part both constructors share, once a device exists: the context is built at once, so
     /// that a failure past this point is cleaned up by its `Drop`, which respects `ownership`.
     fn assemble(parts: Parts) -> Result<Self> {
-        let Parts { entry, instance, messenger, debug_utils, physical, device, .. } = parts;
+        let Parts { entry, instance, messenger, surface, debug_utils, physical, device, .. } = parts;
         let props = unsafe { instance.get_physical_device_properties(physical) };
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let limits = props.limits;
@@ -295,6 +305,7 @@ impl Context {
             _entry: entry,
             instance,
             messenger,
+            surface,
             physical,
             device,
             queue_family: parts.queue_family,
@@ -307,6 +318,7 @@ impl Context {
             info,
             log: parts.log,
             destroyed: false,
+            window: None,
         };
         ctx.allocator = Some(Mutex::new(Allocator::new(&AllocatorCreateDesc {
             instance: ctx.instance.clone(),
@@ -419,6 +431,9 @@ impl Context {
             self.allocator = None;
             if self.ownership == Ownership::Owned {
                 self.device.destroy_device(None);
+                if let Some((loader, surface)) = self.surface.take() {
+                    loader.destroy_surface(surface, None);
+                }
                 if let Some((loader, messenger)) = self.messenger.take() {
                     loader.destroy_debug_utils_messenger(messenger, None);
                 }
@@ -434,15 +449,19 @@ impl Drop for Context {
     }
 }
 
-/// Destroys a half-built instance (and its messenger) if construction fails.
+/// Destroys a half-built instance (its surface and messenger too) if construction fails.
 struct InstanceGuard {
     instance: Option<ash::Instance>,
     messenger: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    surface: Option<Surface>,
 }
 
 impl Drop for InstanceGuard {
     fn drop(&mut self) {
         unsafe {
+            if let Some((loader, surface)) = self.surface.take() {
+                loader.destroy_surface(surface, None);
+            }
             if let Some((loader, messenger)) = self.messenger.take() {
                 loader.destroy_debug_utils_messenger(messenger, None);
             }

@@ -73,12 +73,24 @@ pub struct DeviceFilter<'a> {
     /// What `supports` checks, in words completing "a queue family that …" for the error raised
     /// when no family passes.
     pub requirement: &'a str,
+    /// Creates the window's surface once the instance exists (it must exist before a device is
+    /// picked); the chosen queue family must then also present to it. The context keeps the
+    /// surface and destroys it before the instance.
+    pub surface: Option<&'a CreateSurface<'a>>,
 }
+
+/// Makes a surface on a fresh instance (see [`DeviceFilter::surface`]).
+pub type CreateSurface<'a> = dyn Fn(&ash::Entry, &ash::Instance) -> Result<vk::SurfaceKHR> + 'a;
 
 impl DeviceFilter<'static> {
     /// No extras: every graphics and compute queue family with timestamps will do.
-    pub const HEADLESS: DeviceFilter<'static> =
-        DeviceFilter { instance_extensions: &[], device_extensions: &[], supports: &any_family, requirement: "" };
+    pub const HEADLESS: DeviceFilter<'static> = DeviceFilter {
+        instance_extensions: &[],
+        device_extensions: &[],
+        supports: &any_family,
+        requirement: "",
+        surface: None,
+    };
 }
 
 fn any_family(_: &ash::Instance, _: vk::PhysicalDevice, _: u32) -> bool {
@@ -93,15 +105,24 @@ pub(super) struct Suitable {
     pub depth_stencil_format: vk::Format,
 }
 
-/// A real GPU when present, lavapipe otherwise; `wanted` (a name substring) overrides. The
-/// error names each device and why it cannot be used.
-pub(super) fn pick_device(instance: &ash::Instance, wanted: Option<&str>, filter: &DeviceFilter) -> Result<Suitable> {
+/// A surface and its instance-level commands.
+pub(super) type Surface = (ash::khr::surface::Instance, vk::SurfaceKHR);
+
+/// A real GPU when present, lavapipe otherwise; `wanted` (a name substring) overrides. With a
+/// `surface`, only queue families that can present to it qualify. The error names each device
+/// and why it cannot be used.
+pub(super) fn pick_device(
+    instance: &ash::Instance,
+    wanted: Option<&str>,
+    filter: &DeviceFilter,
+    surface: Option<&Surface>,
+) -> Result<Suitable> {
     let devices = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     let mut usable = Vec::new();
     let mut refused = Vec::new();
     for physical in devices {
         let props = unsafe { instance.get_physical_device_properties(physical) };
-        match suitability(instance, physical, &props, filter) {
+        match suitability(instance, physical, &props, filter, surface) {
             Ok((queue_family, depth_stencil_format)) => {
                 usable.push(Suitable { physical, props, queue_family, depth_stencil_format })
             }
@@ -135,6 +156,7 @@ fn suitability(
     physical: vk::PhysicalDevice,
     props: &vk::PhysicalDeviceProperties,
     filter: &DeviceFilter,
+    surface: Option<&Surface>,
 ) -> std::result::Result<(u32, vk::Format), String> {
     api_1_3(props)?;
     let available = unsafe { instance.enumerate_device_extension_properties(physical) }.unwrap_or_default();
@@ -155,7 +177,12 @@ fn suitability(
     }
     let family = capable
         .into_iter()
-        .find(|&i| (filter.supports)(instance, physical, i))
+        .find(|&i| {
+            (filter.supports)(instance, physical, i)
+                && surface.is_none_or(|(loader, surface)| {
+                    unsafe { loader.get_physical_device_surface_support(physical, i, *surface) }.unwrap_or(false)
+                })
+        })
         .ok_or_else(|| format!("no graphics and compute queue family that {}", filter.requirement))?;
     Ok((family, depth_stencil_format(instance, physical)?))
 }

@@ -1,5 +1,5 @@
 //! The only Vulkan plumbing: context (own or the embedder's handles), memory, targets (own or
-//! wrapped), barriers, pipelines, shaders, timestamps, frames and readback. Nothing here knows
+//! wrapped), barriers, pipelines, shaders, timestamps, frames, readback and the swapchain. Nothing here knows
 //! about shadows.
 
 mod barrier;
@@ -13,13 +13,16 @@ mod pipeline;
 pub mod reflect;
 mod render;
 pub mod shaders;
+mod swapchain;
 mod target;
 mod timestamps;
 mod upload;
 
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
 pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership};
-pub use device::{DeviceFilter, required_core_features, required_device_extensions, required_vulkan13_features};
+pub use device::{
+    CreateSurface, DeviceFilter, required_core_features, required_device_extensions, required_vulkan13_features,
+};
 pub use frames::{FRAMES_IN_FLIGHT, Frame, FrameRing, Semaphores};
 pub use guard::{Destroy, Guard};
 pub use memory::{Buffer, PerFrame};
@@ -29,6 +32,7 @@ pub use render::{
     Attachment, RenderPass, dispatch, draw_fullscreen, draw_indexed, draw_indirect, draw_vertices, fullscreen,
     update_buffer,
 };
+pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{copy_to_buffer, copy_to_target, upload};

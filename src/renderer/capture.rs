@@ -10,7 +10,7 @@ use super::CameraTargets;
 use crate::error::{Error, Result};
 use crate::frame::{RAW_VISIBILITY_FORMAT, ShadowRole, Surfaces, quantize};
 use crate::geometry::CameraProjection;
-use crate::gpu::{Buffer, Context, copy_to_buffer};
+use crate::gpu::{Buffer, Context, Target, copy_to_buffer};
 
 /// Bytes per pixel read back: RGBA8 color, D32 depth, RGBA16F normal + receives, then V: R16,
 /// or R32F for raw visibility.
@@ -22,12 +22,19 @@ pub(super) fn readback_size(w: u32, h: u32, visibility: vk::Format) -> u64 {
     w as u64 * h as u64 * pixel_bytes(visibility).iter().sum::<u64>()
 }
 
-pub(super) fn record_copies(ctx: &Context, cmd: vk::CommandBuffer, t: &CameraTargets, dst: &Buffer) {
+/// Copies color (`color`, or the engine's color target), depth, normal and V into `dst`.
+pub(super) fn record_copies(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    t: &CameraTargets,
+    color: Option<&Target>,
+    dst: &Buffer,
+) {
     let extent = t.color.extent();
     let pixels = extent.width as u64 * extent.height as u64;
     let mut offset = 0;
     let bytes = pixel_bytes(t.visibility.desc.format);
-    for (target, bytes) in [&t.color, &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
+    for (target, bytes) in [color.unwrap_or(&t.color), &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
         copy_to_buffer(ctx, cmd, target, dst, &[target.whole_copy(offset)]);
         offset += pixels * bytes;
     }

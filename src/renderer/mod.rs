@@ -5,6 +5,7 @@
 mod capture;
 mod draw;
 mod passes;
+mod window;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -17,6 +18,7 @@ use gpu_allocator::MemoryLocation;
 pub use capture::{Capture, pixel_uv};
 use draw::MeshCache;
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
+pub use window::{AppWindow, Presented, WindowOptions, WindowStats};
 
 use crate::error::Result;
 use crate::frame::interface::{FrameGlobals, ObjectData};
@@ -66,9 +68,9 @@ impl FrameSettings {
 #[derive(Clone, Debug)]
 pub struct FrameTimings {
     pub passes: Vec<PassTime>,
-    /// In order: [`WAIT_FOR_SLOT`], `draw list`, `prepass`, `technique` (its per-frame geometry
-    /// and recording), `composite`, [`SUBMIT`]; a captured frame adds `wait for GPU` and
-    /// `readback`.
+    /// In order: [`WAIT_FOR_SLOT`], `acquire` (a presented frame), `draw list`, `prepass`,
+    /// `technique` (its per-frame geometry and recording), `composite`, [`SUBMIT`], `present` (a
+    /// presented frame); a captured frame adds `wait for GPU` and `readback`.
     pub cpu: Vec<CpuSpan>,
 }
 
@@ -191,6 +193,8 @@ pub struct Engine {
     timing_history: usize,
     /// CPU spans of submitted frames whose GPU times have not come back yet, oldest first.
     cpu_spans: std::collections::VecDeque<Vec<CpuSpan>>,
+    /// The swapchain of an [`Engine::windowed`] engine.
+    window: Option<window::Presenter>,
     // Declared last: dropped after everything above is destroyed in `Drop`.
     ctx: Context,
 }
@@ -198,7 +202,11 @@ pub struct Engine {
 impl Engine {
     /// An engine rendering offscreen (tests, the command line, benchmarks).
     pub fn headless(options: &ContextOptions) -> Result<Self> {
-        let ctx = Context::headless(options)?;
+        Engine::on(Context::headless(options)?)
+    }
+
+    /// The engine's passes on `ctx`; headless and windowed engines differ only in their context.
+    fn on(ctx: Context) -> Result<Self> {
         let mut engine = Engine {
             frames: None,
             prepass: None,
@@ -215,13 +223,14 @@ impl Engine {
             timings: Default::default(),
             timing_history: DEFAULT_TIMING_HISTORY,
             cpu_spans: Default::default(),
+            window: None,
             ctx,
         };
         // On error, `Drop` destroys whatever was made.
         let ctx = &engine.ctx;
         engine.frames = Some(FrameRing::new(ctx)?);
         engine.prepass = Some(Prepass::new(ctx)?);
-        engine.composite = Some(Composite::new(ctx)?);
+        engine.composite = Some(Composite::new(ctx, COLOR_FORMAT)?);
         let size = std::mem::size_of::<FrameGlobals>() as u64;
         engine.globals =
             Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
@@ -253,12 +262,12 @@ impl Engine {
     /// Renders one frame. Its GPU times become available a frame or two later, in
     /// [`Engine::take_timings`].
     pub fn render(&mut self, scene: &Scene, settings: &FrameSettings) -> Result<()> {
-        self.frame(scene, settings, false).map(|_| ())
+        self.frame(scene, settings, false, None).map(|_| ())
     }
 
     /// Renders one frame and reads its color and visibility images back (waits for the GPU).
     pub fn render_and_capture(&mut self, scene: &Scene, settings: &FrameSettings) -> Result<Capture> {
-        Ok(self.frame(scene, settings, true)?.expect("capture requested"))
+        Ok(self.frame(scene, settings, true, None)?.expect("capture requested"))
     }
 
     /// Timings of the frames finished since the last call, oldest first: the newest
@@ -302,7 +311,16 @@ impl Engine {
         }
     }
 
-    fn frame(&mut self, scene: &Scene, settings: &FrameSettings, capture: bool) -> Result<Option<Capture>> {
+    /// Renders a frame into the engine's color target, or into a swapchain image of `window`,
+    /// which it acquires, waits on and presents; `None` when not captured, or when the swapchain
+    /// is out of date (the frame is dropped before anything is recorded).
+    fn frame(
+        &mut self,
+        scene: &Scene,
+        settings: &FrameSettings,
+        capture: bool,
+        mut window: Option<&mut window::Presenter>,
+    ) -> Result<Option<Capture>> {
         scene.validate()?;
         let (w, h) = (settings.width, settings.height);
         self.ensure_targets(w, h)?;
@@ -313,6 +331,14 @@ impl Engine {
         let mut clock = SpanClock::start();
         let (mut frame, earlier) = frames.begin(ctx)?;
         clock.mark(WAIT_FOR_SLOT);
+        if let Some(w) = window.as_deref_mut() {
+            let acquired = w.acquire(frame.slot)?;
+            clock.mark("acquire");
+            if !acquired {
+                self.push_timings(earlier);
+                return Ok(None);
+            }
+        }
         let number = self.frame_number;
         self.frame_number += 1;
         // The fence just waited on covers every frame up to `number - FRAMES_IN_FLIGHT`.
@@ -396,7 +422,14 @@ impl Engine {
         };
         technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
         clock.mark("technique");
-        self.composite.as_ref().expect("built").record(ctx, &mut frame, targets, globals_range)?;
+        let (composite, into) = match window.as_deref_mut() {
+            Some(w) => {
+                let (composite, image) = w.output();
+                (composite, Some(image))
+            }
+            None => (self.composite.as_ref().expect("built"), None),
+        };
+        composite.record(ctx, &mut frame, targets, into, globals_range)?;
         if capture {
             let size = capture::readback_size(w, h, self.visibility_format);
             if self.readback.as_ref().is_none_or(|b| b.size != size) {
@@ -407,23 +440,36 @@ impl Engine {
                 self.readback = Some(Buffer::new(ctx, "readback", size, usage, MemoryLocation::GpuToCpu)?);
             }
             let readback = self.readback.as_ref().expect("ensured");
+            let mut into = window.as_deref_mut().map(|w| w.output().1);
             transition(
                 ctx,
                 frame.cmd,
                 &mut [
-                    (&mut targets.color, Access::COPY_READ, false),
+                    (into.as_deref_mut().unwrap_or(&mut targets.color), Access::COPY_READ, false),
                     (&mut targets.depth, Access::COPY_READ, false),
                     (&mut targets.normal, Access::COPY_READ, false),
                     (&mut targets.visibility, Access::COPY_READ, false),
                 ],
             );
-            capture::record_copies(ctx, frame.cmd, targets, readback);
+            capture::record_copies(ctx, frame.cmd, targets, into.as_deref(), readback);
             copy_to_host(ctx, frame.cmd);
         }
         let slot = frame.slot;
+        // A swapchain image goes to the presentation engine once the frame is done with it.
+        let [wait, signal] = match window.as_deref_mut() {
+            Some(w) => {
+                transition(ctx, frame.cmd, &mut [(w.output().1, Access::PRESENT, false)]);
+                w.semaphores(slot).map(|s| vec![s])
+            }
+            None => [vec![], vec![]],
+        };
         let frames = self.frames.as_mut().expect("engine is built");
-        frames.submit(ctx, slot, &crate::gpu::Semaphores::NONE)?;
+        frames.submit(ctx, slot, &crate::gpu::Semaphores { wait: &wait, signal: &signal })?;
         clock.mark(SUBMIT);
+        if let Some(w) = window {
+            w.present(ctx)?;
+            clock.mark("present");
+        }
         self.push_timings(earlier);
         if !capture {
             self.cpu_spans.push_back(clock.spans);
@@ -496,6 +542,7 @@ impl Engine {
         std::mem::take(&mut self.meshes).destroy(ctx);
         self.targets.take().into_iter().for_each(|t| t.destroy(ctx));
         self.readback.take().into_iter().for_each(|b| b.destroy(ctx));
+        self.window.take().into_iter().for_each(|w| w.destroy(ctx));
         self.globals.take().into_iter().chain(self.objects.take()).for_each(|b| b.destroy(ctx));
         self.prepass.take().into_iter().for_each(|p| p.destroy(ctx));
         self.composite.take().into_iter().for_each(|p| p.destroy(ctx));

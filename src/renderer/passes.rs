@@ -6,8 +6,8 @@ use super::CameraTargets;
 use crate::error::Result;
 use crate::frame::{Draw, MESH_POSITIONS_NORMALS};
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc, RenderPass,
-    fullscreen, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc, RenderPass, Target,
+    fullscreen, is_srgb, shaders, transition,
 };
 
 /// Facet normal + shadow role, read by the techniques.
@@ -88,37 +88,41 @@ impl Prepass {
     }
 }
 
-/// Composite: ambient + V·Lambert into the sRGB color target.
+/// Composite: ambient + V·Lambert into the sRGB color target, or a swapchain image.
 pub struct Composite {
     pipeline: Pipeline,
 }
 
 impl Composite {
-    pub fn new(ctx: &Context) -> Result<Self> {
-        let pipeline =
-            Pipeline::fullscreen(ctx, &Fullscreen::new("composite", &shaders::COMPOSITE_COMPOSITE_FRAG, COLOR_FORMAT))?;
-        Ok(Composite { pipeline })
+    /// Writes `format`: sRGB-encoded by the hardware for an sRGB format, by the shader otherwise.
+    pub fn new(ctx: &Context, format: vk::Format) -> Result<Self> {
+        let constants = [("ENCODE_SRGB", u32::from(!is_srgb(format)))];
+        let desc = Fullscreen::new("composite", &shaders::COMPOSITE_COMPOSITE_FRAG, format).constants(&constants);
+        Ok(Composite { pipeline: Pipeline::fullscreen(ctx, &desc)? })
     }
 
+    /// Composites into `into` (of this composite's format), or the engine's color target.
     pub fn record(
         &self,
         ctx: &Context,
         frame: &mut Frame<'_>,
         t: &mut CameraTargets,
+        into: Option<&mut Target>,
         globals: vk::DescriptorBufferInfo,
     ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "composite");
+        let color = into.unwrap_or(&mut t.color);
         transition(
             ctx,
             cmd,
-            &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (&mut t.color, Access::COLOR_WRITE, true)],
+            &mut [(&mut t.visibility, Access::FRAGMENT_READ, false), (color, Access::COLOR_WRITE, true)],
         );
         fullscreen(
             ctx,
             cmd,
             &self.pipeline,
-            &t.color,
+            color,
             &[
                 Descriptor::Buffer(globals),
                 Descriptor::Image(&t.depth),
