@@ -1,9 +1,14 @@
 //! Techniques: each owns its targets, pipelines and passes, and writes the visibility image V.
 //! A technique builds only what the scene in front of it needs.
 
+pub mod blob;
+pub mod concentric;
 mod falloff;
+mod ground;
 pub mod knobs;
+mod object_ids;
 pub mod plateau;
+pub mod projective_texture;
 pub mod reference;
 pub mod registry;
 pub mod shadow_map;
@@ -31,6 +36,9 @@ pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &reference::INFO,
     &traced::RAYTRACE,
     &traced::PARKER,
+    &blob::INFO,
+    &concentric::INFO,
+    &projective_texture::INFO,
 ];
 
 /// A shadowing technique: records its passes and leaves V written (the composite transitions
