@@ -8,6 +8,7 @@ mod ground;
 pub mod knobs;
 mod object_ids;
 pub mod plateau;
+pub mod priority_map;
 pub mod projective_texture;
 pub mod reference;
 pub mod registry;
@@ -39,6 +40,7 @@ pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &blob::INFO,
     &concentric::INFO,
     &projective_texture::INFO,
+    &priority_map::INFO,
 ];
 
 /// A shadowing technique: records its passes and leaves V written (the composite transitions
