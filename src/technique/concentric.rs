@@ -21,8 +21,11 @@
 //! light's foot no penumbra and a far one too much), and the shadow stays on the ground plane
 //! (off it, receivers are unshadowed; casters keep only their own back faces' darkness).
 //!
-//! As Komura notes for Gooch's and Haines' methods alike, the umbra is too large: the average
-//! of hard shadows around the point light's keeps the full hard shadow's half-tone line.
+//! Komura's slide "Problems with Gooch et al. and Haine's method" finds the umbra too large,
+//! as a point light makes it. That holds for the plateau, which keeps the whole hard shadow as
+//! its top; with planes spread evenly on both sides of the ground, as here, the penumbra
+//! straddles the hard edge (darker inside, lighter outside) and the umbra shrinks as an area
+//! light's does, which is why this measures closer to the reference than the plateau does.
 
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
