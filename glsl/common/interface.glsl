@@ -74,4 +74,30 @@ struct SampleView {
     vec4 pad[8];
 };
 
+// The classic systems' frame (blob, concentric, projective texture).
+struct ClassicView {
+    vec4 plane_origin;  // xyz; w = how far off the plane a surface may be and still be on it
+    vec4 plane_normal;  // xyz
+    vec4 plane_u;       // xyz
+    vec4 plane_v;       // xyz
+    vec4 window;        // u0, v0, u1, v1: the part of the plane a plan-view texture covers
+    vec4 params;        // blob: count, softness; projective texture: count
+};
+
+// A blob (glsl/blob/resolve.frag): plane coordinates relative to `centre` times `to_unit`
+// land in the unit disk inside the ellipse.
+struct BlobData {
+    vec4 centre;   // u, v
+    vec4 to_unit;  // the 2x2 matrix, column-major: m00, m10, m01, m11
+};
+
+// One caster's image in the projective-texture atlas. 256 bytes: bound one at a time as a
+// uniform buffer by the pass that draws it.
+struct CasterImage {
+    mat4 view_proj;  // world -> the image's clip space (w: distance in front of the light)
+    vec4 tile;       // the tile in atlas uv: x0, y0, width, height
+    vec4 info;       // x: distance from the light to the caster's bounding sphere; y: its object index
+    vec4 pad[10];
+};
+
 #endif

@@ -89,6 +89,38 @@ pub struct SampleView {
     pub pad: [Vec4; 8],
 }
 
+/// The classic systems' frame (blob, concentric, projective texture): the receiver plane, the
+/// window of it a plan-view texture covers, and the technique's counts and knobs.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ClassicView {
+    pub plane_origin: Vec4,
+    pub plane_normal: Vec4,
+    pub plane_u: Vec4,
+    pub plane_v: Vec4,
+    pub window: Vec4,
+    pub params: Vec4,
+}
+
+/// A blob on the receiver plane: its centre and the 2x2 matrix to the unit disk.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct BlobData {
+    pub centre: Vec4,
+    pub to_unit: Vec4,
+}
+
+/// One caster's black-on-white image in the projective-texture atlas, padded to 256 bytes
+/// (see `LightSample`) so that the pass drawing it binds one element as a uniform buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CasterImage {
+    pub view_proj: Mat4,
+    pub tile: Vec4,
+    pub info: Vec4,
+    pub pad: [Vec4; 10],
+}
+
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
@@ -96,3 +128,6 @@ const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
 const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
 const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);
 const _: () = assert!(std::mem::size_of::<SampleView>() == 256);
+const _: () = assert!(std::mem::size_of::<ClassicView>() == 6 * 16);
+const _: () = assert!(std::mem::size_of::<BlobData>() == 2 * 16);
+const _: () = assert!(std::mem::size_of::<CasterImage>() == 256);

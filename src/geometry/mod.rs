@@ -1,8 +1,9 @@
 //! Pure math, no Vulkan and no scene types: edge adjacency, procedural shapes, bounds, projections, convex clipping, light-frustum fitting, light
-//! sampling and shadow volumes.
+//! sampling, shadow volumes, and the classic systems' blobs, concentric planes and caster views.
 
 pub mod adjacency;
 mod bounds;
+pub mod classic;
 mod clip;
 mod light_frustum;
 mod light_samples;

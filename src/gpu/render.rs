@@ -18,6 +18,11 @@ impl<'a> Attachment<'a> {
         Attachment { target, clear: Some(vk::ClearValue { color: vk::ClearColorValue { float32: rgba } }) }
     }
 
+    /// A color attachment of an integer format cleared to `value`.
+    pub fn clear_uint(target: &'a Target, value: [u32; 4]) -> Self {
+        Attachment { target, clear: Some(vk::ClearValue { color: vk::ClearColorValue { uint32: value } }) }
+    }
+
     pub fn clear_depth(target: &'a Target, depth: f32) -> Self {
         Attachment {
             target,

@@ -2,10 +2,16 @@
 //! A technique builds only what the scene in front of it needs.
 
 mod accumulation;
+pub mod blob;
+pub mod concentric;
 mod falloff;
+mod ground;
 pub mod knobs;
+mod object_ids;
 pub mod planar;
 pub mod plateau;
+pub mod priority_map;
+pub mod projective_texture;
 pub mod reference;
 pub mod registry;
 pub mod shadow_map;
@@ -33,6 +39,10 @@ pub const TECHNIQUES: &[&TechniqueInfo] = &[
     &smoothie::INFO,
     &shadow_volume::INFO,
     &planar::INFO,
+    &blob::INFO,
+    &concentric::INFO,
+    &projective_texture::INFO,
+    &priority_map::INFO,
     &reference::INFO,
     &traced::RAYTRACE,
     &traced::PARKER,

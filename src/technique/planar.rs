@@ -18,7 +18,7 @@ use ash::vk;
 use glam::Vec4;
 
 use super::accumulation::{Accumulation, SAMPLES, StencilRule, end_span, span, stencil};
-use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map::draw_casters;
 use super::{Technique, clear_visibility};
 use crate::error::Result;
@@ -41,6 +41,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::GroundPlane,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 /// Stencil values: the plane is visible (1), and this hard shadow covers it (2).

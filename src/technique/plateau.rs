@@ -29,7 +29,7 @@ use glam::{Mat4, Vec2, Vec4};
 
 use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params};
-use super::registry::{CostGoal, Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
 use super::{Technique, clear_visibility, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
@@ -61,6 +61,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     // Issue 4: plateaus against the hard map at the same screen size.
     cost_goal: Some(CostGoal { setting: &[], baseline: &shadow_map::INFO, baseline_setting: &[], max_ratio: 1.3 }),
     receivers: Receivers::GroundPlane,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 const TEXTURE_SIZE: Knob = Knob {

@@ -20,7 +20,7 @@ use bytemuck::{Zeroable as _, cast_slice};
 use glam::{Vec3, Vec4};
 
 use super::knobs::{Knob, Params};
-use super::registry::{Kind, Receivers, Runs, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, Runs, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{
     DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, caster_bounds, depth_pipeline, draw_casters, warn_clipped,
 };
@@ -50,6 +50,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     },
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 const SAMPLES: Knob = Knob {

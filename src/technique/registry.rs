@@ -79,7 +79,16 @@ pub struct TechniqueInfo {
     pub sweep_knobs: SweepKnobs,
     pub cost_goal: Option<CostGoal>,
     pub receivers: Receivers,
+    /// The accuracy claimed across every scene the technique accepts: its RMSE against the
+    /// exact truth exceeds the hard shadow's by at most this (`tests/truths.rs` holds it).
+    /// `None` claims nothing but sound V (the blob: the floor of the curve).
+    pub error_bound: Option<f64>,
 }
+
+/// The error bound of the approximations: no worse than the hard shadow of a point light at the
+/// light's centre plus this RMSE, across lights from a point to 1e6 m (PCF's fixed kernel at a
+/// point light measured up to 0.07 at 40 px).
+pub const APPROXIMATION_BOUND: f64 = 0.15;
 
 /// Which surfaces a technique can shadow: a stated limit of the method, which the accuracy
 /// checks respect (they compare a plane-only technique with a truth in which only the ground

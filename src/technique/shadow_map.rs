@@ -14,7 +14,7 @@ use bytemuck::bytes_of;
 use glam::Vec4;
 
 use super::knobs::{Knob, Params};
-use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::LightView;
@@ -35,6 +35,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 /// Percentage-closer filtering (Reeves, Salesin & Cook 1987) on the same map.
@@ -48,6 +49,7 @@ pub const PCF: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 /// Percentage-closer soft shadows (Fernando 2005) on the same map.
@@ -61,6 +63,7 @@ pub const PCSS: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 const TAPS: Knob =

@@ -39,7 +39,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::accumulation::{Accumulation, SAMPLES, StencilRule, end_span, span, stencil};
 use super::knobs::{Knob, Params};
-use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::{Technique, clear_visibility};
 use crate::error::Result;
 use crate::frame::FrameInputs;
@@ -63,6 +63,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 const COUNTING: Knob = Knob {

@@ -25,7 +25,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params};
-use super::registry::{CostGoal, Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::smoothie_gpu::GpuSilhouettes;
 use super::{Technique, clear_visibility, resolve, surface_inputs};
@@ -60,6 +60,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         max_ratio: 1.3,
     }),
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 /// The paper's map is smaller than the hard shadow map's default.

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use ash::vk;
 
 use super::knobs::{Knob, Params};
-use super::registry::{Kind, Receivers, Runs, SweepKnobs, TechniqueInfo};
+use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, Runs, SweepKnobs, TechniqueInfo};
 use super::{Technique, refuse_wide_lights};
 use crate::error::Result;
 use crate::frame::{FrameInputs, RAW_VISIBILITY_FORMAT, Surfaces, quantize};
@@ -25,6 +25,7 @@ pub const RAYTRACE: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs { short: &[("samples", "64")], long: &[("samples", "64")], huge: &[("samples", "4")] },
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 pub const PARKER: TechniqueInfo = TechniqueInfo {
@@ -37,6 +38,7 @@ pub const PARKER: TechniqueInfo = TechniqueInfo {
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
+    error_bound: Some(APPROXIMATION_BOUND),
 };
 
 const SAMPLES: Knob =
