@@ -29,4 +29,18 @@ pub mod scene;
 pub mod technique;
 
 pub use error::{Error, Result};
-pub use renderer::{Capture, CpuSpan, Engine, FrameSettings, FrameTimings};
+pub use renderer::{
+    Capture, CpuSpan, EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, FrameSettings, FrameTimings, Recorded,
+};
+
+/// The device extensions an embedder enables on the device it creates for the engine
+/// ([`Engine::from_handles`]).
+pub fn required_device_extensions() -> &'static [&'static std::ffi::CStr] {
+    gpu::required_device_extensions()
+}
+
+/// The Vulkan 1.3 features an embedder enables on the device it creates for the engine (chain
+/// them into `VkDeviceCreateInfo`, and hand the same to [`gpu::EmbedderHandles`]).
+pub fn required_device_features() -> ash::vk::PhysicalDeviceVulkan13Features<'static> {
+    gpu::required_vulkan13_features()
+}

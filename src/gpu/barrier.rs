@@ -62,6 +62,9 @@ impl Access {
         access: vk::AccessFlags2::SHADER_SAMPLED_READ,
         layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
     };
+    /// Sampled by fragment shaders (the depth aspect of a depth-stencil image).
+    pub const DEPTH_STENCIL_FRAGMENT_READ: Access =
+        Access { layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL, ..Access::DEPTH_FRAGMENT_READ };
     /// Written by a copy (an image computed on the CPU).
     pub const COPY_WRITE: Access = Access {
         stage: vk::PipelineStageFlags2::COPY,

@@ -5,7 +5,7 @@ use ash::vk;
 
 use super::Context;
 use super::timestamps::{PassTime, PassTimer};
-use crate::error::{Result, VkContext};
+use crate::error::{Error, Result, VkContext};
 
 /// Frames the CPU may record ahead of the GPU.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -103,6 +103,44 @@ impl FrameRing {
         }
         s.timer.reset(ctx, s.cmd);
         Ok((Frame { slot, cmd: s.cmd, timer: &mut s.timer }, earlier))
+    }
+
+    /// Begins a frame recorded into the embedder's `cmd`, which the embedder submits. The slot's
+    /// previous frame must have finished on the GPU (the embedder waited for it), or this is an
+    /// error that says so. Returns the pass times of every earlier frame that has finished, oldest
+    /// first: the last one's too when the GPU keeps up. End it with [`FrameRing::recorded_external`].
+    pub fn begin_external(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<(Frame<'_>, Vec<Vec<PassTime>>)> {
+        let slot = self.next;
+        let mut done = Vec::new();
+        for k in 0..FRAMES_IN_FLIGHT {
+            let s = &mut self.slots[(slot + k) % FRAMES_IN_FLIGHT];
+            // A frame of our own on the slot we take (an engine that also renders) has its fence;
+            // an embedder's frame left it signalled.
+            if k == 0 {
+                unsafe { ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+            }
+            match s.timer.collect(ctx, &mut self.gpu_origin) {
+                Ok(times) => done.extend(times),
+                // A newer frame still running: its times come with a later frame.
+                Err(Error::Vulkan { result: vk::Result::NOT_READY, .. }) if k > 0 => break,
+                Err(Error::Vulkan { result: vk::Result::NOT_READY, .. }) => {
+                    return Err(Error::Invalid(format!(
+                        "the frame recorded {FRAMES_IN_FLIGHT} frames ago has not finished on the GPU: wait \
+                         for it (its fence) before recording another, and submit every recorded frame"
+                    )));
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        let s = &mut self.slots[slot];
+        s.timer.reset(ctx, cmd);
+        Ok((Frame { slot, cmd, timer: &mut s.timer }, done))
+    }
+
+    /// The embedder's frame on `slot` is recorded (and will be submitted by the embedder).
+    pub fn recorded_external(&mut self, slot: usize) {
+        self.slots[slot].timer.submitted();
+        self.next = (slot + 1) % FRAMES_IN_FLIGHT;
     }
 
     /// Ends and submits the frame begun last, waiting on and signalling `semaphores`.

@@ -73,17 +73,21 @@ impl PassTimer {
         }
     }
 
-    /// The submitted frame's pass times; call only after its fence signalled. `None` when no
+    /// The submitted frame's pass times, once its queries are written (after its fence signalled,
+    /// or an embedder's frame that finished); `None` when no
     /// frame was submitted since the last call. `origin` is the raw timestamp that begin times
     /// count from, set by the first call: raw values can be so large (on an H100's driver) that
     /// an f64 of milliseconds since the counter's own zero blurs them by tenths of a microsecond.
     pub fn collect(&mut self, ctx: &Context, origin: &mut Option<u64>) -> Result<Option<Vec<PassTime>>> {
-        if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
+        if !self.recorded || self.names.is_empty() {
+            self.recorded = false;
             return Ok(None);
         }
         let mut raw = vec![0u64; self.names.len() * 2];
+        // Without a wait: NOT_READY (the frame is still running) leaves the frame to collect later.
         unsafe { ctx.device.get_query_pool_results(self.pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64) }
             .vk("vkGetQueryPoolResults")?;
+        self.recorded = false;
         let bits = ctx.info.timestamp_valid_bits;
         let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         let ms = ctx.info.timestamp_period_ns as f64 * 1e-6;
