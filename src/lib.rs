@@ -19,6 +19,7 @@
 //! ```
 
 pub mod error;
+pub mod ffi;
 pub mod frame;
 pub mod geometry;
 pub mod gpu;

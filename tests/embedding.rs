@@ -12,7 +12,7 @@ use glam::{Mat4, Vec3, Vec4};
 use softshadow::gpu::Access;
 use softshadow::scene::Scene;
 use softshadow::technique::{Params, find};
-use softshadow::{EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, Error};
+use softshadow::{EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, Error, Recorded};
 
 use common::embedder::{Embedder, HostBuffer, Image, barrier, whole};
 
@@ -152,6 +152,16 @@ struct Frames {
     fence: vk::Fence,
     /// What the engine left V in last time (the embedder's readback moves it on from there).
     visibility_last: Access,
+    /// V goes to the engine's own target instead of `visibility`.
+    own_target: bool,
+}
+
+/// What one frame shows: the scene (its box at `box_x`), the technique, the embedder's camera.
+struct Shot<'a> {
+    scene: &'a Scene,
+    params: &'a Params,
+    camera: EmbedderCamera,
+    box_x: f32,
 }
 
 impl Frames {
@@ -172,27 +182,52 @@ impl Frames {
             cmd: e.command_buffer(),
             fence: e.fence(false),
             visibility_last: Access::NONE,
+            own_target: false,
         }
     }
 
     /// One frame: upload depth (and normals), record the engine's passes, copy V out, submit,
-    /// wait. Returns V, or the engine's error (the command buffer is then dropped unsubmitted).
-    fn run(
+    /// wait. Returns V, or the engine's error (the command buffer is then left unsubmitted).
+    fn run(&mut self, e: &Embedder, engine: &mut Engine, shot: &Shot) -> Result<Vec<u16>, Error> {
+        let cmd = self.cmd;
+        e.begin(cmd);
+        let recorded = self.record(e, engine, shot, cmd)?;
+        assert_eq!(recorded.visibility, Access::FRAGMENT_READ);
+        assert_eq!(recorded.visibility_image, self.visibility.image);
+        let d = &e.device;
+        let copy_read = Access::COPY_READ;
+        let color = vk::ImageAspectFlags::COLOR;
+        barrier(d, cmd, self.visibility.image, color, triple(recorded.visibility), triple(copy_read));
+        unsafe {
+            let copy = [whole(color, EXTENT)];
+            d.cmd_copy_image_to_buffer(cmd, self.visibility.image, copy_read.layout, self.readback.buffer, &copy);
+            let host = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COPY)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+            d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
+        }
+        self.visibility_last = copy_read;
+        e.submit(cmd, self.fence);
+        e.wait(self.fence);
+        Ok(bytemuck::cast_slice(&self.readback.read()).to_vec())
+    }
+
+    /// Uploads the shot's depth (and normals) in `cmd` and records the engine's passes after
+    /// them, V into the embedder's image (or, with `own_target`, the engine's).
+    fn record(
         &mut self,
         e: &Embedder,
         engine: &mut Engine,
-        s: &Scene,
-        p: &Params,
-        cam: EmbedderCamera,
-        box_x: f32,
-    ) -> Result<Vec<u16>, Error> {
-        let (depth, normal) = surfaces(&cam, box_x);
+        shot: &Shot,
+        cmd: vk::CommandBuffer,
+    ) -> Result<Recorded, Error> {
+        let (depth, normal) = surfaces(&shot.camera, shot.box_x);
         let depth = depth_bytes(&depth, self.depth.format);
         let normal_at = 16 * SIDE as usize * SIDE as usize;
         self.staging.write(&[&depth[..], &vec![0; normal_at - depth.len()], bytemuck::cast_slice(&normal)].concat());
         let d = &e.device;
-        let cmd = self.cmd;
-        e.begin(cmd);
         let depth_aspect = vk::ImageAspectFlags::DEPTH;
         let full_aspect = match self.depth.format {
             vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT | vk::Format::D16_UNORM_S8_UINT => {
@@ -215,37 +250,12 @@ impl Frames {
         let image = |i: &Image, last| EmbedderImage { image: i.image, format: i.format, extent: EXTENT, last };
         let frame = EmbeddedFrame {
             cmd,
-            camera: cam,
+            camera: shot.camera,
             depth: image(&self.depth, copied),
             normal: self.normal.as_ref().map(|n| image(n, copied)),
-            visibility: Some(image(&self.visibility, self.visibility_last)),
+            visibility: (!self.own_target).then(|| image(&self.visibility, self.visibility_last)),
         };
-        let recorded = engine.record(s, p, &frame)?;
-        assert_eq!(recorded.visibility, Access::FRAGMENT_READ);
-        assert_eq!(recorded.visibility_image, self.visibility.image);
-        let copy_read = Access::COPY_READ;
-        barrier(
-            d,
-            cmd,
-            self.visibility.image,
-            vk::ImageAspectFlags::COLOR,
-            triple(recorded.visibility),
-            triple(copy_read),
-        );
-        unsafe {
-            let copy = [whole(vk::ImageAspectFlags::COLOR, EXTENT)];
-            d.cmd_copy_image_to_buffer(cmd, self.visibility.image, copy_read.layout, self.readback.buffer, &copy);
-            let host = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COPY)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            d.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host));
-        }
-        self.visibility_last = copy_read;
-        e.submit(cmd, self.fence);
-        e.wait(self.fence);
-        Ok(bytemuck::cast_slice(&self.readback.read()).to_vec())
+        engine.record(shot.scene, shot.params, &frame)
     }
 
     fn destroy(self, e: &Embedder) {
@@ -305,7 +315,8 @@ fn an_embedders_frame_gives_the_engines_visibility() {
         let own = own_v(&mut engine, &s, technique);
         let (near, far) = fitted_planes();
         let cam = camera_between(true, near, far);
-        let embedded = frames.run(&e, &mut engine, &s, &params(technique), cam, 0.0).unwrap();
+        let p = params(technique);
+        let embedded = frames.run(&e, &mut engine, &Shot { scene: &s, params: &p, camera: cam, box_x: 0.0 }).unwrap();
         let (over, max) = differences(&embedded, &own, 1);
         eprintln!("{technique}: {over} pixels differ by more than 1 LSB (max {max})");
         // Filters that tap the map at rotated or searched offsets (pcf, pcss, the smoothie's
@@ -335,7 +346,9 @@ fn forward_z_depth_of_every_common_format_without_normals_shadows_alike() {
         [vk::Format::D32_SFLOAT, vk::Format::D16_UNORM, vk::Format::X8_D24_UNORM_PACK32, vk::Format::D24_UNORM_S8_UINT]
     {
         let mut frames = Frames::new(&e, format, false);
-        let embedded = frames.run(&e, &mut engine, &s, &params("pcss"), camera(false), 0.0).unwrap();
+        let p = params("pcss");
+        let shot = Shot { scene: &s, params: &p, camera: camera(false), box_x: 0.0 };
+        let embedded = frames.run(&e, &mut engine, &shot).unwrap();
         frames.destroy(&e);
         let (over, max) = differences(&embedded, &own, 655);
         // Silhouette pixels may see another facet where the depth is coarse.
@@ -349,5 +362,122 @@ fn forward_z_depth_of_every_common_format_without_normals_shadows_alike() {
         );
     }
     drop(engine);
+    e.finish();
+}
+
+/// A moving caster over many recorded frames into the engine's own V target: every pass is
+/// timed (the import, the technique's), its times come back from later frames without a wait,
+/// and the embedded frame costs about what the engine's own frame does.
+#[test]
+fn recorded_frames_are_timed_without_waiting() {
+    let e = embedder();
+    let mut engine = engine_on(&e);
+    let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, false);
+    frames.own_target = true;
+    let p = params("smoothie");
+    let fences = [e.fence(true), e.fence(true)];
+    let cmds = [e.command_buffer(), e.command_buffer()];
+    const FRAMES: usize = 12;
+    for i in 0..FRAMES {
+        let box_x = (i as f32 * 0.3).sin();
+        let s = scene(box_x);
+        // Frame i − 2 used this slot: wait for it, as the contract asks.
+        e.wait(fences[i % 2]);
+        e.begin(cmds[i % 2]);
+        frames
+            .record(&e, &mut engine, &Shot { scene: &s, params: &p, camera: camera(true), box_x }, cmds[i % 2])
+            .unwrap();
+        e.submit(cmds[i % 2], fences[i % 2]);
+    }
+    fences.iter().for_each(|&f| unsafe { e.device.wait_for_fences(&[f], true, u64::MAX) }.unwrap());
+    let timings = engine.take_timings();
+    assert!(timings.len() >= FRAMES - 2, "{} of {FRAMES} frames timed", timings.len());
+    for t in &timings {
+        let names: Vec<_> = t.passes.iter().map(|p| p.name).collect();
+        assert_eq!(names, ["import", "shadow_map", "smoothie_buffer", "resolve"], "{names:?}");
+        assert!(t.passes.iter().all(|p| p.ms > 0.0), "{:?}", t.passes);
+    }
+    let median = |t: &[softshadow::FrameTimings]| {
+        let mut ms: Vec<f64> = t.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect();
+        ms.sort_by(f64::total_cmp);
+        ms[ms.len() / 2]
+    };
+    let embedded = median(&timings);
+    let s = scene(0.0);
+    let mut settings = common::settings(&s, SIDE, SIDE);
+    settings.params = p.clone();
+    for _ in 0..FRAMES {
+        engine.render(&s, &settings).unwrap();
+    }
+    engine.flush().unwrap();
+    let own = median(&engine.take_timings());
+    eprintln!("GPU ms per frame ({}): embedded {embedded:.3}, engine's own path {own:.3}", engine.device().name);
+    fences.iter().for_each(|&f| unsafe { e.device.destroy_fence(f, None) });
+    frames.destroy(&e);
+    drop(engine);
+    e.finish();
+}
+
+/// Recording again before the frame two records ago has finished is refused with a message
+/// saying so (the GPU is held on an event the host sets afterwards); once it has finished,
+/// recording works again.
+#[test]
+fn recording_over_an_unfinished_frame_is_an_error() {
+    let e = embedder();
+    let mut engine = engine_on(&e);
+    let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, false);
+    frames.own_target = true;
+    let (s, p) = (scene(0.0), params("shadow-map"));
+    let shot = Shot { scene: &s, params: &p, camera: camera(true), box_x: 0.0 };
+    let event = unsafe { e.device.create_event(&vk::EventCreateInfo::default(), None) }.unwrap();
+    let cmds = [e.command_buffer(), e.command_buffer(), e.command_buffer()];
+    let fences = [e.fence(false), e.fence(false), e.fence(false)];
+    for i in 0..2 {
+        e.begin(cmds[i]);
+        if i == 0 {
+            let held = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::HOST)
+                .src_access_mask(vk::AccessFlags2::HOST_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                .dst_access_mask(vk::AccessFlags2::MEMORY_READ)];
+            let dep = [vk::DependencyInfo::default().memory_barriers(&held)];
+            unsafe { e.device.cmd_wait_events2(cmds[0], &[event], &dep) };
+        }
+        eprintln!("recording {i}");
+        frames.record(&e, &mut engine, &shot, cmds[i]).unwrap();
+        eprintln!("submitting {i}");
+        e.submit(cmds[i], fences[i]);
+    }
+    e.begin(cmds[2]);
+    eprintln!("recording 2");
+    let why = frames.record(&e, &mut engine, &shot, cmds[2]).err().expect("frame 0 is still held").to_string();
+    assert!(why.contains("has not finished"), "{why}");
+    unsafe { e.device.set_event(event) }.unwrap();
+    (0..2).for_each(|i| e.wait(fences[i]));
+    e.begin(cmds[2]);
+    frames.record(&e, &mut engine, &shot, cmds[2]).unwrap();
+    e.submit(cmds[2], fences[2]);
+    e.wait(fences[2]);
+    unsafe {
+        e.device.destroy_event(event, None);
+        fences.iter().for_each(|&f| e.device.destroy_fence(f, None));
+    }
+    frames.destroy(&e);
+    drop(engine);
+    e.finish();
+}
+
+/// A device created without what the engine needs is refused, the missing piece named.
+#[test]
+fn an_embedders_device_without_what_the_engine_needs_is_refused_by_name() {
+    let without_extensions = Embedder::new(&[], softshadow::required_device_features());
+    let features = softshadow::required_device_features();
+    let why = unsafe { Engine::from_handles(without_extensions.handles(features)) }.err().expect("refused").to_string();
+    assert!(why.contains("VK_KHR_push_descriptor"), "{why}");
+    without_extensions.finish();
+    let e = embedder();
+    let handles = e.handles(softshadow::required_device_features().dynamic_rendering(false));
+    let why = unsafe { Engine::from_handles(handles) }.err().expect("refused").to_string();
+    assert!(why.contains("dynamicRendering"), "{why}");
     e.finish();
 }

@@ -138,6 +138,9 @@ impl BufferAccess {
     /// Written by `vkCmdUpdateBuffer` (a copy-stage transfer).
     pub const TRANSFER_WRITE: BufferAccess =
         BufferAccess { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
+    /// Read by the host (after a fence, or a mark it polls).
+    pub const HOST_READ: BufferAccess =
+        BufferAccess { stage: vk::PipelineStageFlags2::HOST, access: vk::AccessFlags2::HOST_READ };
     /// Read and written (atomics, appends) by a compute shader.
     pub const COMPUTE_READ_WRITE: BufferAccess = BufferAccess {
         stage: vk::PipelineStageFlags2::COMPUTE_SHADER,

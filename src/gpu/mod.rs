@@ -31,4 +31,4 @@ pub use render::{
 };
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
-pub use upload::{copy_to_buffer, copy_to_target, upload};
+pub use upload::{copy_to_buffer, copy_to_target, upload, upload_in};

@@ -338,7 +338,7 @@ impl Engine {
         let mut clock = SpanClock::start();
         let (mut frame, earlier) = frames.begin(ctx)?;
         clock.mark(WAIT_FOR_SLOT);
-        let prepared = self.data.prepare(ctx, scene, frame.slot, None, vk::Extent2D { width: w, height: h })?;
+        let prepared = self.data.prepare(ctx, &frame, scene, None, vk::Extent2D { width: w, height: h })?;
         clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
         self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, prepared.inputs(), &prepared.draws)?;
@@ -374,6 +374,7 @@ impl Engine {
         let slot = frame.slot;
         let frames = self.frames.as_mut().expect("engine is built");
         frames.submit(ctx, slot, &crate::gpu::Semaphores::NONE)?;
+        self.data.meshes.commit();
         clock.mark(SUBMIT);
         self.push_timings(earlier);
         if !capture {
@@ -454,7 +455,7 @@ impl Engine {
         std::mem::take(&mut self.wrapped[slot]).into_iter().for_each(|t| t.destroy(ctx));
         let mut images = Wrapped::new(ctx, frame)?;
         let mut record = || -> Result<Recorded> {
-            let prepared = self.data.prepare(ctx, scene, slot, Some(projection), extent)?;
+            let prepared = self.data.prepare(ctx, &gpu_frame, scene, Some(projection), extent)?;
             clock.mark("draw list");
             let targets = self.targets.as_mut().expect("ensured");
             let import = ImportTargets {
@@ -486,7 +487,8 @@ impl Engine {
         // buffer may still refer to them until the embedder resets it).
         self.wrapped[slot] = images.into_targets();
         let recorded = recorded?;
-        self.frames.as_mut().expect("engine is built").recorded_external(slot);
+        self.frames.as_mut().expect("engine is built").end_external(ctx, slot, frame.cmd);
+        self.data.meshes.commit();
         self.push_timings(earlier);
         self.cpu_spans.push_back(clock.spans);
         Ok(recorded)

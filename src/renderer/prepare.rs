@@ -40,16 +40,19 @@ pub(super) struct Prepared {
 }
 
 impl FrameData {
-    /// Prepares a frame in `slot` (whose previous frame has finished) at `extent`, seen by
-    /// `camera`, or by the scene's camera fitted to the scene when `None`.
+    /// Prepares `frame` (its slot's previous frame has finished; new meshes are uploaded in its
+    /// command buffer) at `extent`, seen by `camera`, or by the scene's camera fitted to the
+    /// scene when `None`.
     pub fn prepare(
         &mut self,
         ctx: &Context,
+        frame: &Frame<'_>,
         scene: &Scene,
-        slot: usize,
         camera: Option<CameraProjection>,
         extent: vk::Extent2D,
     ) -> Result<Prepared> {
+        self.meshes.drop_uncommitted(ctx);
+        let slot = frame.slot;
         let number = self.number;
         self.number += 1;
         // The slot's previous frame, and so every frame up to `number - FRAMES_IN_FLIGHT`, is done.
@@ -64,7 +67,7 @@ impl FrameData {
             let model = o.transform.matrix();
             let bounds = o.mesh.bounds.transformed(&model);
             let instance = objects.len() as u32;
-            draws.push(self.meshes.draw(ctx, &o.mesh, number, instance, bounds, (o.casts, o.receives))?);
+            draws.push(self.meshes.draw(ctx, frame.cmd, &o.mesh, number, instance, bounds, (o.casts, o.receives))?);
             objects.push(object_data(
                 model,
                 Mat4::from_mat3(o.normal_matrix()),
@@ -75,7 +78,15 @@ impl FrameData {
         if let Some(g) = &scene.ground {
             let model = ground_model(g);
             let instance = objects.len() as u32;
-            draws.push(self.meshes.draw(ctx, &self.ground_mesh, number, instance, g.bounds(), (false, true))?);
+            draws.push(self.meshes.draw(
+                ctx,
+                frame.cmd,
+                &self.ground_mesh,
+                number,
+                instance,
+                g.bounds(),
+                (false, true),
+            )?);
             objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, ShadowRole::Receives));
         }
         let bytes: &[u8] = cast_slice(&objects);
