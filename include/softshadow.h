@@ -153,6 +153,9 @@ const char *softshadow_version(void);
 // Copies the calling thread's last error message into `buf` (at most `len` bytes, NUL
 // included, truncated to fit; nothing when `buf` is NULL or `len` is 0) and returns the
 // message's full length without the NUL. Safe to call at any time; "" before any error.
+//
+// # Safety
+// `buf` is NULL or writable for `len` bytes.
 size_t softshadow_last_error(char *buf, size_t len);
 
 // The device extensions an embedder's device must enable, one at a time: `index` from 0;

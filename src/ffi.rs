@@ -290,8 +290,11 @@ pub extern "C" fn softshadow_version() -> *const c_char {
 /// Copies the calling thread's last error message into `buf` (at most `len` bytes, NUL
 /// included, truncated to fit; nothing when `buf` is NULL or `len` is 0) and returns the
 /// message's full length without the NUL. Safe to call at any time; "" before any error.
+///
+/// # Safety
+/// `buf` is NULL or writable for `len` bytes.
 #[unsafe(no_mangle)]
-pub extern "C" fn softshadow_last_error(buf: *mut c_char, len: usize) -> usize {
+pub unsafe extern "C" fn softshadow_last_error(buf: *mut c_char, len: usize) -> usize {
     catch_unwind(|| {
         LAST_ERROR.with(|e| {
             let message = e.borrow();
@@ -313,7 +316,7 @@ pub extern "C" fn softshadow_last_error(buf: *mut c_char, len: usize) -> usize {
 /// NULL past the last. Static strings.
 #[unsafe(no_mangle)]
 pub extern "C" fn softshadow_required_device_extension(index: usize) -> *const c_char {
-    crate::required_device_extensions().get(index).map_or(std::ptr::null(), |e| e.as_ptr())
+    crate::gpu::required_device_extensions().get(index).map_or(std::ptr::null(), |e| e.as_ptr())
 }
 
 fn new_engine(engine: Engine, out_engine: *mut *mut softshadow_engine) -> Result<(), Failure> {
@@ -372,7 +375,7 @@ pub unsafe extern "C" fn softshadow_engine_create_from_vulkan(
             device,
             queue_family: v.queue_family,
             queue_index: v.queue_index,
-            enabled_features: crate::required_device_features(),
+            enabled_features: crate::gpu::required_vulkan13_features(),
         };
         // SAFETY: the caller's contract, passed on.
         let engine = unsafe { Engine::from_handles(handles) }?;
@@ -671,7 +674,7 @@ fn object(i: usize, o: &softshadow_object) -> Result<Object, Failure> {
     if o.positions.is_null() || o.indices.is_null() {
         return Err(Failure(SOFTSHADOW_ERROR_NULL, format!("{name}: positions or indices is NULL")));
     }
-    if o.index_count == 0 || o.index_count % 3 != 0 {
+    if o.index_count == 0 || !o.index_count.is_multiple_of(3) {
         return Err(invalid(format!("{name}: {} indices is not a positive multiple of 3", o.index_count)));
     }
     // SAFETY: the caller's contract: the arrays hold the counts given.
@@ -836,13 +839,13 @@ mod tests {
         let status = guard(|| panic!("on purpose"));
         assert_eq!(status, SOFTSHADOW_ERROR_PANIC);
         let mut buf = [0 as c_char; 64];
-        let len = softshadow_last_error(buf.as_mut_ptr(), buf.len());
+        let len = unsafe { softshadow_last_error(buf.as_mut_ptr(), buf.len()) };
         let message = unsafe { CStr::from_ptr(buf.as_ptr()) }.to_str().unwrap();
         assert_eq!(message, "softshadow panicked: on purpose");
         assert_eq!(len, message.len());
         // Truncated to the room given, still terminated.
         let mut small = [1 as c_char; 5];
-        assert_eq!(softshadow_last_error(small.as_mut_ptr(), small.len()), len);
+        assert_eq!(unsafe { softshadow_last_error(small.as_mut_ptr(), small.len()) }, len);
         assert_eq!(unsafe { CStr::from_ptr(small.as_ptr()) }.to_str().unwrap(), "soft");
     }
 }

@@ -194,7 +194,7 @@ mod tests {
         }
     }
 
-    /// An embedder's matrices, forward Z (glam's right-handed look-at, a [0, 1] depth
+    /// An embedder's matrices, forward Z or reverse (a right-handed look-at, a [0, 1] depth
     /// perspective with y flipped for Vulkan), give the camera [`CameraProjection::new`] makes:
     /// the same position, axis and reverse-Z depth of every point.
     #[test]
@@ -202,14 +202,27 @@ mod tests {
         let (eye, target) = (Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO);
         let ours =
             CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene());
-        let view = Mat4::look_at_rh(eye, target, Vec3::Y);
-        let mut proj = Mat4::perspective_rh(60f32.to_radians(), 1.5, 0.5, 20.0);
-        proj.y_axis.y = -proj.y_axis.y;
-        for (proj, reverse) in [(proj, false), (Mat4::perspective_rh(60f32.to_radians(), 1.5, 20.0, 0.5), true)] {
-            let mut proj = proj;
-            if reverse {
-                proj.y_axis.y = -proj.y_axis.y;
-            }
+        // A right-handed look-at (view down −z) and [0, 1]-depth perspectives, y flipped for
+        // Vulkan: depth 0 at `z0`, 1 at `z1`.
+        let (f, s) = ((target - eye).normalize(), (target - eye).normalize().cross(Vec3::Y).normalize());
+        let u = s.cross(f);
+        let view = Mat4::from_cols(
+            glam::Vec4::new(s.x, u.x, -f.x, 0.0),
+            glam::Vec4::new(s.y, u.y, -f.y, 0.0),
+            glam::Vec4::new(s.z, u.z, -f.z, 0.0),
+            glam::Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+        );
+        let perspective = |z0: f32, z1: f32| {
+            let g = 1.0 / 30f32.to_radians().tan();
+            Mat4::from_cols(
+                glam::Vec4::new(g / 1.5, 0.0, 0.0, 0.0),
+                glam::Vec4::new(0.0, -g, 0.0, 0.0),
+                glam::Vec4::new(0.0, 0.0, z1 / (z0 - z1), -1.0),
+                glam::Vec4::new(0.0, 0.0, z0 * z1 / (z0 - z1), 0.0),
+            )
+        };
+        let proj = perspective(0.5, 20.0);
+        for (proj, reverse) in [(proj, false), (perspective(20.0, 0.5), true)] {
             let theirs = CameraProjection::from_matrices(view, proj, reverse, 0.5, 20.0).unwrap();
             assert!((theirs.position - eye).length() < 1e-4, "{:?}", theirs.position);
             assert!((theirs.forward - ours.forward).length() < 1e-5);

@@ -112,12 +112,17 @@ impl MeshCache {
         }
     }
 
-    /// Destroys meshes that no frame after `completed` uses (frames up to it have finished),
-    /// and the staging buffers of uploads made by those frames.
-    pub fn evict(&mut self, ctx: &Context, completed: u64) {
+    /// Destroys the staging buffers of uploads by frames up to `completed` (finished).
+    pub fn release_staging(&mut self, ctx: &Context, completed: u64) {
         for m in self.meshes.values_mut().filter(|m| m.uploaded_in <= completed) {
             m.staging.drain(..).for_each(|b| b.destroy(ctx));
         }
+    }
+
+    /// Destroys meshes that no frame after `completed` uses (frames up to it have finished),
+    /// and the staging buffers of uploads made by those frames.
+    pub fn evict(&mut self, ctx: &Context, completed: u64) {
+        self.release_staging(ctx, completed);
         let stale: Vec<MeshId> =
             self.meshes.iter().filter(|(_, m)| m.last_used <= completed).map(|(id, _)| *id).collect();
         for id in stale {

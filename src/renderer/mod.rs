@@ -203,8 +203,8 @@ impl Engine {
 
     /// An engine on the embedder's instance and device ([`Context::from_handles`]): it creates
     /// and destroys only its own objects, never the instance, device or queue. The device must
-    /// have been created with [`required_device_extensions`](crate::required_device_extensions)
-    /// and [`required_device_features`](crate::required_device_features); a device without one is
+    /// have been created with [`required_device_extensions`](crate::gpu::required_device_extensions)
+    /// and [`required_vulkan13_features`](crate::gpu::required_vulkan13_features) (at the crate root: `required_device_features`); a device without one is
     /// refused with an error that names it. Record frames into the embedder's command buffers
     /// with [`Engine::record`].
     ///
@@ -301,11 +301,14 @@ impl Engine {
         }
     }
 
-    /// Waits for every frame in flight, so that their timings are available.
+    /// Waits for every frame in flight, so that their timings are available. On an engine that
+    /// records into the embedder's command buffers, call it only once the embedder has waited
+    /// for its frames (their fences are the embedder's).
     pub fn flush(&mut self) -> Result<()> {
         let frames = self.frames.as_mut().expect("engine is built");
         let done = frames.drain(&self.ctx)?;
         self.push_timings(done);
+        self.release_staging();
         Ok(())
     }
 
@@ -315,6 +318,13 @@ impl Engine {
         self.destroy_resources();
         self.ctx.destroy();
         self.ctx.validation_errors()
+    }
+
+    /// Every frame begun has finished: their uploads' staging buffers can go.
+    fn release_staging(&mut self) {
+        if let Some(last) = self.data.number.checked_sub(1) {
+            self.data.meshes.release_staging(&self.ctx, last);
+        }
     }
 
     fn push_timings(&mut self, done: impl IntoIterator<Item = Vec<PassTime>>) {
@@ -401,6 +411,7 @@ impl Engine {
             bar.finish_and_clear();
         }
         clock.mark("wait for GPU");
+        self.release_staging();
         let readback = self.readback.as_ref().expect("ensured");
         let mut capture = Capture::read(readback, w, h, &prepared.camera, self.visibility_format);
         if let Some((_, t)) = &self.technique
