@@ -25,11 +25,16 @@ const FAR: f32 = 30.0;
 
 /// A box on a ground square under an area light, seen in perspective.
 fn scene(box_x: f32) -> Scene {
+    scene_with(box_x, true, Vec3::new(2.0, 6.0, 1.0))
+}
+
+/// [`scene`], its box receiving shadows or not, the light at `light`.
+fn scene_with(box_x: f32, receives: bool, light: Vec3) -> Scene {
     common::scene(&format!(
         "[camera]\nposition = [{}, {}, {}]\ntarget = [0.0, 0.0, 0.0]\nfov_y_deg = {FOV_DEG}\n\
-         [light]\nposition = [2.0, 6.0, 1.0]\nradius = 0.3\n[ground]\nheight = 0.0\nhalf_size = 4.0\n\
-         [[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nposition = [{box_x}, 0.5, 0.0]\n",
-        EYE.x, EYE.y, EYE.z
+         [light]\nposition = [{}, {}, {}]\nradius = 0.3\n[ground]\nheight = 0.0\nhalf_size = 4.0\n\
+         [[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nposition = [{box_x}, 0.5, 0.0]\nreceives = {receives}\n",
+        EYE.x, EYE.y, EYE.z, light.x, light.y, light.z
     ))
 }
 
@@ -328,6 +333,18 @@ fn an_embedders_frame_gives_the_engines_visibility() {
         let (shadowed, lit) = (v_at(&embedded, Vec3::new(-0.75, 0.0, -0.1)), v_at(&embedded, Vec3::new(2.0, 0.0, 2.0)));
         assert!(shadowed < 0.05 && lit > 0.95, "{technique}: V {shadowed} in the umbra, {lit} in the open");
     }
+    // The casters' roles come from the engine's scene: lit from behind, the box's face toward
+    // the camera is in its own shadow; a box that casts but receives nothing has V = 1 there, as
+    // on the engine's own path, where the embedder's depth alone would make it a shadowed receiver.
+    let s = scene_with(0.0, false, Vec3::new(-2.0, 6.0, -1.0));
+    let p = params("shadow-map");
+    let embedded =
+        frames.run(&e, &mut engine, &Shot { scene: &s, params: &p, camera: camera(true), box_x: 0.0 }).unwrap();
+    let own = own_v(&mut engine, &s, "shadow-map");
+    let face = Vec3::new(0.0, 0.5, 0.5);
+    assert_eq!((v_at(&embedded, face), v_at(&own, face)), (1.0, 1.0), "V on the box's face away from the light");
+    let behind = Vec3::new(0.75, 0.0, 0.3);
+    assert!(v_at(&embedded, behind) < 0.05, "V {} where the box's shadow falls", v_at(&embedded, behind));
     frames.destroy(&e);
     drop(engine);
     e.finish();
