@@ -19,6 +19,7 @@
 //! ```
 
 pub mod error;
+pub mod ffi;
 pub mod frame;
 pub mod geometry;
 pub mod gpu;
@@ -30,5 +31,24 @@ pub mod technique;
 
 pub use error::{Error, Result};
 pub use renderer::{
-    AppWindow, Capture, CpuSpan, Engine, FrameSettings, FrameTimings, Presented, WindowOptions, WindowStats,
+    AppWindow, Capture, CpuSpan, EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, FrameSettings, FrameTimings,
+    Presented, Recorded, WindowOptions, WindowStats,
 };
+
+/// The device extensions an embedder enables on the device it creates for the engine
+/// ([`Engine::from_handles`]).
+pub fn required_device_extensions() -> &'static [&'static std::ffi::CStr] {
+    gpu::required_device_extensions()
+}
+
+/// The Vulkan 1.0 features an embedder enables on the device it creates for the engine (set them
+/// in `VkPhysicalDeviceFeatures`, and hand the same to [`gpu::EmbedderHandles`]).
+pub fn required_core_features() -> ash::vk::PhysicalDeviceFeatures {
+    gpu::required_core_features()
+}
+
+/// The Vulkan 1.3 features an embedder enables on the device it creates for the engine (chain
+/// them into `VkDeviceCreateInfo`, and hand the same to [`gpu::EmbedderHandles`]).
+pub fn required_device_features() -> ash::vk::PhysicalDeviceVulkan13Features<'static> {
+    gpu::required_vulkan13_features()
+}

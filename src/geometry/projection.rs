@@ -102,6 +102,62 @@ impl CameraProjection {
         }
     }
 
+    /// An embedder's camera: `view` (world → view) and `projection` (view → Vulkan clip, y
+    /// down, depth in [0, 1]) as they render with, depth reversed (near 1, far 0) or not, and
+    /// the near and far distances along the view axis that bound what it sees (finite, also
+    /// for an infinite projection). Forward-Z matrices are flipped (depth → 1 − depth) so that
+    /// the result is reverse-Z like [`CameraProjection::new`]'s. Errors name what is wrong.
+    pub fn from_matrices(view: Mat4, projection: Mat4, reverse_z: bool, near: f32, far: f32) -> Result<Self, String> {
+        let finite = |m: &Mat4| m.to_cols_array().iter().all(|v| v.is_finite());
+        if !finite(&view) || !finite(&projection) {
+            return Err("the camera's view and projection matrices must be finite".into());
+        }
+        if !(near.is_finite() && far.is_finite() && far > near) {
+            return Err(format!("the camera's near ({near}) and far ({far}) must be finite with near < far"));
+        }
+        let (view64, proj) = (view.as_dmat4(), projection.as_dmat4());
+        // z' = w − z turns forward-Z clip depth d into 1 − d.
+        let flip =
+            DMat4::from_cols(DVec4::X, DVec4::Y, DVec4::new(0.0, 0.0, -1.0, 0.0), DVec4::new(0.0, 0.0, 1.0, 1.0));
+        let view_proj = if reverse_z { proj * view64 } else { flip * proj * view64 };
+        let det = view_proj.determinant();
+        if !(det.is_finite() && det.abs() > 1e-300) || view64.determinant().abs() < 1e-300 {
+            return Err("the camera's view or projection matrix is singular".into());
+        }
+        let inv = view_proj.inverse();
+        let unproject = |x: f64, y: f64, z: f64| {
+            let w = inv * DVec4::new(x, y, z, 1.0);
+            w.truncate() / w.w
+        };
+        let position = view64.inverse().w_axis.truncate();
+        // The optical axis: where the projection maps x = y = 0, from near (1) toward far.
+        let forward = (unproject(0.0, 0.0, 0.5) - unproject(0.0, 0.0, 1.0)).normalize();
+        if !forward.is_finite() {
+            return Err("the camera's projection has no view axis".into());
+        }
+        let ndc_z = |d: f32| {
+            let c = view_proj * (position + forward * d as f64).extend(1.0);
+            c.z / c.w
+        };
+        let (z_near, z_far) = (ndc_z(near), ndc_z(far));
+        if !(z_near.is_finite() && z_far.is_finite()) {
+            return Err(format!("near {near} or far {far} falls outside the camera's projection"));
+        }
+        let corners = std::array::from_fn(|i| {
+            let x = if i & 1 == 0 { -1.0 } else { 1.0 };
+            let y = if i & 2 == 0 { -1.0 } else { 1.0 };
+            unproject(x, y, if i & 4 == 0 { z_near } else { z_far }).as_vec3()
+        });
+        Ok(CameraProjection {
+            view_proj: view_proj.as_mat4(),
+            inv_view_proj: inv.as_mat4(),
+            position: position.as_vec3(),
+            forward: forward.as_vec3(),
+            inv64: inv,
+            frustum: Hexahedron { corners },
+        })
+    }
+
     fn unproject(&self, uv: Vec2, depth: f64) -> glam::DVec3 {
         let ndc = uv.as_dvec2() * 2.0 - 1.0;
         let w = self.inv64 * DVec4::new(ndc.x, ndc.y, depth, 1.0);
@@ -141,6 +197,50 @@ mod tests {
             assert!(ndc(&cam.view_proj, Vec3::X * 0.5).x > 0.0);
             assert!(ndc(&cam.view_proj, Vec3::Y * 0.5).y < 0.0);
         }
+    }
+
+    /// An embedder's matrices, forward Z or reverse (a right-handed look-at, a [0, 1] depth
+    /// perspective with y flipped for Vulkan), give the camera [`CameraProjection::new`] makes:
+    /// the same position, axis and reverse-Z depth of every point.
+    #[test]
+    fn an_embedders_matrices_give_the_same_camera() {
+        let (eye, target) = (Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO);
+        let ours =
+            CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene());
+        // A right-handed look-at (view down −z) and [0, 1]-depth perspectives, y flipped for
+        // Vulkan: depth 0 at `z0`, 1 at `z1`.
+        let (f, s) = ((target - eye).normalize(), (target - eye).normalize().cross(Vec3::Y).normalize());
+        let u = s.cross(f);
+        let view = Mat4::from_cols(
+            glam::Vec4::new(s.x, u.x, -f.x, 0.0),
+            glam::Vec4::new(s.y, u.y, -f.y, 0.0),
+            glam::Vec4::new(s.z, u.z, -f.z, 0.0),
+            glam::Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+        );
+        let perspective = |z0: f32, z1: f32| {
+            let g = 1.0 / 30f32.to_radians().tan();
+            Mat4::from_cols(
+                glam::Vec4::new(g / 1.5, 0.0, 0.0, 0.0),
+                glam::Vec4::new(0.0, -g, 0.0, 0.0),
+                glam::Vec4::new(0.0, 0.0, z1 / (z0 - z1), -1.0),
+                glam::Vec4::new(0.0, 0.0, z0 * z1 / (z0 - z1), 0.0),
+            )
+        };
+        let proj = perspective(0.5, 20.0);
+        for (proj, reverse) in [(proj, false), (perspective(20.0, 0.5), true)] {
+            let theirs = CameraProjection::from_matrices(view, proj, reverse, 0.5, 20.0).unwrap();
+            assert!((theirs.position - eye).length() < 1e-4, "{:?}", theirs.position);
+            assert!((theirs.forward - ours.forward).length() < 1e-5);
+            for p in [Vec3::new(0.3, -0.2, 0.1), Vec3::new(-1.0, 0.5, 1.0)] {
+                let (a, b) = (ndc(&ours.view_proj, p), ndc(&theirs.view_proj, p));
+                assert!((a.x - b.x).abs() < 1e-5 && (a.y - b.y).abs() < 1e-5, "{a} {b}");
+                // Reverse Z in both (near > far), whatever the fitted planes.
+                assert!(ndc(&theirs.view_proj, p - ours.forward).z > b.z, "{b}");
+                assert!((theirs.inv_view_proj.project_point3(b) - p).length() < 1e-3);
+            }
+        }
+        assert!(CameraProjection::from_matrices(view, Mat4::ZERO, false, 0.5, 20.0).is_err());
+        assert!(CameraProjection::from_matrices(view, proj, false, 20.0, 0.5).is_err());
     }
 
     #[test]

@@ -62,6 +62,9 @@ impl Access {
         access: vk::AccessFlags2::SHADER_SAMPLED_READ,
         layout: vk::ImageLayout::DEPTH_READ_ONLY_OPTIMAL,
     };
+    /// Sampled by fragment shaders (the depth aspect of a depth-stencil image).
+    pub const DEPTH_STENCIL_FRAGMENT_READ: Access =
+        Access { layout: vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL, ..Access::DEPTH_FRAGMENT_READ };
     /// Written by a copy (an image computed on the CPU).
     pub const COPY_WRITE: Access = Access {
         stage: vk::PipelineStageFlags2::COPY,
@@ -143,6 +146,9 @@ impl BufferAccess {
     /// Written by `vkCmdUpdateBuffer` (a copy-stage transfer).
     pub const TRANSFER_WRITE: BufferAccess =
         BufferAccess { stage: vk::PipelineStageFlags2::COPY, access: vk::AccessFlags2::TRANSFER_WRITE };
+    /// Read by the host (after a fence, or a mark it polls).
+    pub const HOST_READ: BufferAccess =
+        BufferAccess { stage: vk::PipelineStageFlags2::HOST, access: vk::AccessFlags2::HOST_READ };
     /// Read and written (atomics, appends) by a compute shader.
     pub const COMPUTE_READ_WRITE: BufferAccess = BufferAccess {
         stage: vk::PipelineStageFlags2::COMPUTE_SHADER,

@@ -3,9 +3,13 @@
 
 use ash::vk;
 
+use gpu_allocator::MemoryLocation;
+
 use super::Context;
-use super::timestamps::{PassTime, PassTimer};
-use crate::error::{Result, VkContext};
+use super::barrier::{BufferAccess, buffer_barrier};
+use super::memory::Buffer;
+use super::timestamps::{PassTime, PassTimer, RESULT_BYTES};
+use crate::error::{Error, Result, VkContext};
 
 /// Frames the CPU may record ahead of the GPU.
 pub const FRAMES_IN_FLIGHT: usize = 2;
@@ -23,6 +27,20 @@ pub struct FrameRing {
     next: usize,
     /// The raw GPU timestamp that pass begin times count from.
     gpu_origin: Option<u64>,
+    /// Made by the first embedder's frame.
+    external: Option<External>,
+}
+
+/// Per slot in [`External::buffer`]: the progress mark (padded to 8 bytes), then the timestamps.
+const SLOT_BYTES: u64 = 8 + RESULT_BYTES;
+
+/// What the host reads of embedders' frames, which it has no fence for.
+struct External {
+    buffer: Buffer,
+    /// The mark the next frame writes (never 0, the buffer's first contents).
+    next_mark: u32,
+    /// The mark each slot's unfinished frame will write.
+    pending: [Option<u32>; FRAMES_IN_FLIGHT],
 }
 
 /// A frame being recorded.
@@ -59,7 +77,7 @@ impl FrameRing {
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
         let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
-        let mut ring = FrameRing { pool, slots: Vec::new(), next: 0, gpu_origin: None };
+        let mut ring = FrameRing { pool, slots: Vec::new(), next: 0, gpu_origin: None, external: None };
         if let Err(e) = ring.fill(ctx) {
             ring.destroy(ctx);
             return Err(e);
@@ -103,6 +121,80 @@ impl FrameRing {
         }
         s.timer.reset(ctx, s.cmd);
         Ok((Frame { slot, cmd: s.cmd, timer: &mut s.timer }, earlier))
+    }
+
+    /// Begins a frame recorded into the embedder's `cmd`, which the embedder submits. The slot's
+    /// previous frame must have finished on the GPU (the embedder waited for it), or this is an
+    /// error that says so. Returns the pass times of every earlier frame found finished, oldest
+    /// first: the last one's too when the GPU keeps up. Nothing here waits on the GPU: each
+    /// embedder's frame ends by copying its timestamps and then a progress mark into host memory
+    /// ([`FrameRing::end_external`]), and only those are read.
+    pub fn begin_external(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<(Frame<'_>, Vec<Vec<PassTime>>)> {
+        if self.external.is_none() {
+            let size = FRAMES_IN_FLIGHT as u64 * SLOT_BYTES;
+            let usage = vk::BufferUsageFlags::TRANSFER_DST;
+            self.external = Some(External {
+                buffer: Buffer::new(ctx, "embedded frame progress", size, usage, MemoryLocation::GpuToCpu)?,
+                next_mark: 1,
+                pending: [None; FRAMES_IN_FLIGHT],
+            });
+        }
+        let external = self.external.as_mut().expect("made above");
+        let slot = self.next;
+        let mut done = Vec::new();
+        for k in 0..FRAMES_IN_FLIGHT {
+            let at = (slot + k) % FRAMES_IN_FLIGHT;
+            let s = &mut self.slots[at];
+            match external.pending[at] {
+                // A frame of our own (an engine that also renders) has its fence; none pending
+                // leaves it signalled.
+                None if k == 0 => done.extend(FrameRing::collect_own(ctx, s, &mut self.gpu_origin)?),
+                None => {}
+                Some(mark) => {
+                    let bytes = &external.buffer.read()[at * SLOT_BYTES as usize..][..SLOT_BYTES as usize];
+                    let written = u32::from_le_bytes(bytes[..4].try_into().expect("four bytes"));
+                    if written != mark {
+                        if k == 0 {
+                            return Err(Error::Invalid(format!(
+                                "the frame recorded {FRAMES_IN_FLIGHT} frames ago has not finished on the GPU: \
+                                 wait for it (its fence) before recording another, and submit every recorded frame"
+                            )));
+                        }
+                        // A newer frame still running: its times come with a later frame.
+                        break;
+                    }
+                    let raw: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes[8..]);
+                    done.extend(s.timer.collect_copied(ctx, &raw, &mut self.gpu_origin));
+                    external.pending[at] = None;
+                }
+            }
+        }
+        let s = &mut self.slots[slot];
+        s.timer.reset(ctx, cmd);
+        Ok((Frame { slot, cmd, timer: &mut s.timer }, done))
+    }
+
+    fn collect_own(ctx: &Context, s: &mut Slot, origin: &mut Option<u64>) -> Result<Option<Vec<PassTime>>> {
+        unsafe { ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.vk("vkWaitForFences")?;
+        s.timer.collect(ctx, origin)
+    }
+
+    /// Ends the embedder's frame begun last: records, after all of the frame's work, the copy of
+    /// its timestamps and then its progress mark for the host.
+    pub fn end_external(&mut self, ctx: &Context, slot: usize, cmd: vk::CommandBuffer) {
+        let external = self.external.as_mut().expect("begun with begin_external");
+        let timer = &mut self.slots[slot].timer;
+        let offset = slot as u64 * SLOT_BYTES;
+        let mark = external.next_mark;
+        external.next_mark = external.next_mark.wrapping_add(1).max(1);
+        timer.copy_results(ctx, cmd, external.buffer.buffer, offset + 8);
+        // The mark lands only after the timestamps' copy, and the host reads both after the mark.
+        buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::TRANSFER_WRITE);
+        unsafe { ctx.device.cmd_fill_buffer(cmd, external.buffer.buffer, offset, 4, mark) };
+        buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::HOST_READ);
+        timer.submitted();
+        external.pending[slot] = Some(mark);
+        self.next = (slot + 1) % FRAMES_IN_FLIGHT;
     }
 
     /// Ends and submits the frame begun last, waiting on and signalling `semaphores`.
@@ -156,6 +248,9 @@ impl FrameRing {
     }
 
     pub fn destroy(self, ctx: &Context) {
+        if let Some(external) = self.external {
+            external.buffer.destroy(ctx);
+        }
         for s in self.slots {
             unsafe { ctx.device.destroy_fence(s.fence, None) };
             s.timer.destroy(ctx);

@@ -161,6 +161,32 @@ impl Target {
         Ok(Target { desc, image, view, allocation: None, owns, last: current })
     }
 
+    /// [`Target::wrap`] for an image that passes only sample (the embedder's depth): the view
+    /// made here covers the depth aspect alone, as sampling a depth-stencil image requires,
+    /// while barriers still cover every aspect.
+    pub fn wrap_for_sampling(ctx: &Context, desc: TargetDesc, image: vk::Image, current: Access) -> Result<Self> {
+        check_extent(ctx, &desc)?;
+        let aspect = desc.aspect();
+        let sampled = if aspect.contains(vk::ImageAspectFlags::DEPTH) { vk::ImageAspectFlags::DEPTH } else { aspect };
+        let view = view_of(ctx, image, &desc, sampled)?;
+        Ok(Target { desc, image, view, allocation: None, owns: Owns::View, last: current })
+    }
+
+    /// The image (ours or wrapped), for an embedder to read what the engine wrote.
+    pub fn image(&self) -> vk::Image {
+        self.image
+    }
+
+    /// The view passes read and write it through.
+    pub fn view(&self) -> vk::ImageView {
+        self.view
+    }
+
+    /// The access that last touched it: the state the next user must start from.
+    pub fn last_access(&self) -> Access {
+        self.last
+    }
+
     pub fn extent(&self) -> vk::Extent2D {
         self.desc.extent
     }
@@ -218,11 +244,15 @@ fn check_extent(ctx: &Context, desc: &TargetDesc) -> Result<()> {
 }
 
 fn create_view(ctx: &Context, image: vk::Image, desc: &TargetDesc) -> Result<vk::ImageView> {
+    view_of(ctx, image, desc, desc.aspect())
+}
+
+fn view_of(ctx: &Context, image: vk::Image, desc: &TargetDesc, aspect: vk::ImageAspectFlags) -> Result<vk::ImageView> {
     let view_ci = vk::ImageViewCreateInfo::default()
         .image(image)
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(desc.format)
-        .subresource_range(subresource(desc.aspect()));
+        .subresource_range(subresource(aspect));
     let view = unsafe { ctx.device.create_image_view(&view_ci, None) }.vk("vkCreateImageView")?;
     ctx.name(view, desc.name);
     Ok(view)

@@ -10,6 +10,9 @@ use crate::error::{Result, VkContext};
 /// Passes a frame may time.
 const MAX_PASSES: u32 = 32;
 
+/// Bytes of one frame's timestamps as [`PassTimer::copy_results`] copies them.
+pub const RESULT_BYTES: u64 = MAX_PASSES as u64 * 2 * 8;
+
 /// The GPU time of one pass in one frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
@@ -73,22 +76,44 @@ impl PassTimer {
         }
     }
 
-    /// The submitted frame's pass times; call only after its fence signalled. `None` when no
+    /// The submitted frame's pass times, once its queries are written (after its fence signalled,
+    /// or an embedder's frame that finished); `None` when no
     /// frame was submitted since the last call. `origin` is the raw timestamp that begin times
     /// count from, set by the first call: raw values can be so large (on an H100's driver) that
     /// an f64 of milliseconds since the counter's own zero blurs them by tenths of a microsecond.
     pub fn collect(&mut self, ctx: &Context, origin: &mut Option<u64>) -> Result<Option<Vec<PassTime>>> {
-        if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
+        if !self.recorded || self.names.is_empty() {
+            self.recorded = false;
             return Ok(None);
         }
         let mut raw = vec![0u64; self.names.len() * 2];
         unsafe { ctx.device.get_query_pool_results(self.pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64) }
             .vk("vkGetQueryPoolResults")?;
+        Ok(self.collect_copied(ctx, &raw, origin))
+    }
+
+    /// Records a copy of the frame's timestamps into `dst` at `offset` ([`RESULT_BYTES`] of
+    /// room), made on the GPU once they are written: for frames whose queries the host must not
+    /// poll (some drivers, lavapipe among them, wait for the queue in vkGetQueryPoolResults).
+    pub fn copy_results(&self, ctx: &Context, cmd: vk::CommandBuffer, dst: vk::Buffer, offset: u64) {
+        let count = self.names.len() as u32 * 2;
+        if count > 0 {
+            let flags = vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT;
+            unsafe { ctx.device.cmd_copy_query_pool_results(cmd, self.pool, 0, count, dst, offset, 8, flags) };
+        }
+    }
+
+    /// The submitted frame's pass times from `raw` timestamps (as [`PassTimer::copy_results`]
+    /// copied them, once that copy finished); `None` when no frame was submitted since.
+    pub fn collect_copied(&mut self, ctx: &Context, raw: &[u64], origin: &mut Option<u64>) -> Option<Vec<PassTime>> {
+        if !std::mem::replace(&mut self.recorded, false) || self.names.is_empty() {
+            return None;
+        }
         let bits = ctx.info.timestamp_valid_bits;
         let mask = if bits >= 64 { u64::MAX } else { (1u64 << bits) - 1 };
         let ms = ctx.info.timestamp_period_ns as f64 * 1e-6;
         let origin = *origin.get_or_insert(raw[0] & mask);
-        Ok(Some(
+        Some(
             self.names
                 .iter()
                 .zip(raw.chunks_exact(2))
@@ -98,7 +123,7 @@ impl PassTimer {
                     ms: ticks_since(t[1], t[0], mask) * ms,
                 })
                 .collect(),
-        ))
+        )
     }
 
     pub fn destroy(self, ctx: &Context) {

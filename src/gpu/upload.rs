@@ -12,6 +12,32 @@ use crate::error::{Result, VkContext};
 
 /// Creates a device-local buffer holding `bytes`, through a staging buffer, and waits for it.
 pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    let mut made = None;
+    let result = submit_and_wait(ctx, |cmd| {
+        made = Some(upload_in(ctx, cmd, name, bytes, usage));
+    });
+    let (dst, staging) = made.expect("recorded")?;
+    staging.destroy(ctx);
+    match result {
+        Ok(()) => Ok(dst),
+        Err(e) => {
+            dst.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
+/// Creates a device-local buffer holding `bytes` and records its copy from a staging buffer
+/// into `cmd` (outside a render pass), ordered before later vertex, index and compute reads:
+/// no submission, no wait. Returns the buffer and the staging buffer, which must live until
+/// `cmd` has finished executing.
+pub fn upload_in(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    name: &str,
+    bytes: &[u8],
+    usage: vk::BufferUsageFlags,
+) -> Result<(Buffer, Buffer)> {
     let size = bytes.len() as u64;
     let mut staging = Buffer::new(ctx, "staging", size, vk::BufferUsageFlags::TRANSFER_SRC, MemoryLocation::CpuToGpu)?;
     staging.write(0, bytes);
@@ -22,14 +48,14 @@ pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFla
             return Err(e);
         }
     };
-    let result = submit_and_wait(ctx, |cmd| unsafe {
+    unsafe {
         ctx.device.cmd_copy_buffer(
             cmd,
             staging.buffer,
             dst.buffer,
             &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size }],
         );
-        // Later frames read the data as vertices and indices, or compute shaders read and write
+        // Later passes read the data as vertices and indices, or compute shaders read and write
         // it: order them after the copy.
         let barrier = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
@@ -46,15 +72,8 @@ pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFla
                     | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             )];
         ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
-    });
-    staging.destroy(ctx);
-    match result {
-        Ok(()) => Ok(dst),
-        Err(e) => {
-            dst.destroy(ctx);
-            Err(e)
-        }
     }
+    Ok((dst, staging))
 }
 
 fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {

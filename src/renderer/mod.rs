@@ -4,36 +4,36 @@
 
 mod capture;
 mod draw;
+mod embed;
 mod passes;
+mod prepare;
 mod window;
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use ash::vk;
-use bytemuck::{bytes_of, cast_slice};
-use glam::{Mat4, Vec3, Vec4};
+use glam::Vec3;
 use gpu_allocator::MemoryLocation;
 
 pub use capture::{Capture, pixel_uv};
 use draw::MeshCache;
+pub use embed::{DEPTH_FORMATS, EmbeddedFrame, EmbedderCamera, EmbedderImage, NORMAL_FORMATS, Recorded};
+use embed::{Import, ImportTargets, Wrapped};
 use passes::{ALBEDO_FORMAT, COLOR_FORMAT, Composite, NORMAL_FORMAT, Prepass, SHADING_FORMAT};
+use prepare::FrameData;
 pub use window::{AppWindow, Presented, WindowOptions, WindowStats};
 
-use crate::error::Result;
-use crate::frame::interface::{FrameGlobals, ObjectData};
-use crate::frame::{Draw, FrameInputs, RAW_VISIBILITY_FORMAT, ShadowRole, VISIBILITY_FORMAT};
-use crate::geometry::{Aabb, CameraProjection, Hexahedron, intersection_points};
+use crate::error::{Error, Result};
+use crate::frame::interface::FrameGlobals;
+use crate::frame::{RAW_VISIBILITY_FORMAT, VISIBILITY_FORMAT};
+use crate::geometry::CameraProjection;
 use crate::gpu::{
-    Access, Buffer, Context, ContextOptions, DeviceInfo, FRAMES_IN_FLIGHT, FrameRing, PassTime, PerFrame, Target,
-    TargetDesc, copy_to_host, transition,
+    Access, Buffer, Context, ContextOptions, DeviceInfo, EmbedderHandles, FRAMES_IN_FLIGHT, FrameRing, PassTime,
+    PerFrame, Target, TargetDesc, copy_to_host, transition,
 };
-use crate::scene::{Ground, Mesh, Scene, primitives};
+use crate::scene::{Scene, primitives};
 use crate::technique::{self, Params, Technique};
-
-const AMBIENT: f32 = 0.15;
-const SKY: [f32; 3] = [0.55, 0.62, 0.72];
-const GROUND_COLOR: Vec3 = Vec3::new(0.75, 0.75, 0.72);
 
 /// What to render a frame at: size and technique with its knobs.
 #[derive(Clone, Debug)]
@@ -179,15 +179,15 @@ pub struct Engine {
     frames: Option<FrameRing>,
     prepass: Option<Prepass>,
     composite: Option<Composite>,
-    meshes: MeshCache,
-    globals: Option<PerFrame>,
-    objects: Option<PerFrame>,
+    import: Option<Import>,
+    data: FrameData,
     targets: Option<CameraTargets>,
     readback: Option<Buffer>,
     technique: Option<(&'static str, Box<dyn Technique>)>,
     visibility_format: vk::Format,
-    ground_mesh: Arc<Mesh>,
-    frame_number: u64,
+    /// The embedder's images wrapped by each slot's last frame: their views live until the slot
+    /// comes round again, when that frame has finished.
+    wrapped: [Vec<Target>; FRAMES_IN_FLIGHT],
     /// Finished frames' timings not yet taken, at most `timing_history` of them.
     timings: std::collections::VecDeque<FrameTimings>,
     timing_history: usize,
@@ -205,21 +205,41 @@ impl Engine {
         Engine::on(Context::headless(options)?)
     }
 
-    /// The engine's passes on `ctx`; headless and windowed engines differ only in their context.
+    /// An engine on the embedder's instance and device ([`Context::from_handles`]): it creates
+    /// and destroys only its own objects, never the instance, device or queue. The device must
+    /// have been created with [`required_device_extensions`](crate::gpu::required_device_extensions)
+    /// and [`required_vulkan13_features`](crate::gpu::required_vulkan13_features) (at the crate root: `required_device_features`); a device without one is
+    /// refused with an error that names it. Record frames into the embedder's command buffers
+    /// with [`Engine::record`].
+    ///
+    /// # Safety
+    /// As [`Context::from_handles`]: the handles must be valid, belong together and outlive the
+    /// engine, and the queue must not be used from another thread while the engine waits on it
+    /// (when a frame's size or technique changes, and when it is dropped).
+    pub unsafe fn from_handles(handles: EmbedderHandles) -> Result<Self> {
+        // SAFETY: the caller's promise, passed on.
+        Engine::on(unsafe { Context::from_handles(handles) }?)
+    }
+
+    /// The one construction path, on a context of either kind.
     fn on(ctx: Context) -> Result<Self> {
         let mut engine = Engine {
             frames: None,
             prepass: None,
             composite: None,
-            meshes: MeshCache::default(),
-            globals: None,
-            objects: None,
+            import: None,
+            data: FrameData {
+                meshes: MeshCache::default(),
+                globals: None,
+                objects: None,
+                ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
+                number: 0,
+            },
             targets: None,
             readback: None,
             technique: None,
             visibility_format: VISIBILITY_FORMAT,
-            ground_mesh: Arc::new(primitives::cuboid(Vec3::new(1.0, 0.0, 1.0))?),
-            frame_number: 0,
+            wrapped: Default::default(),
             timings: Default::default(),
             timing_history: DEFAULT_TIMING_HISTORY,
             cpu_spans: Default::default(),
@@ -231,8 +251,9 @@ impl Engine {
         engine.frames = Some(FrameRing::new(ctx)?);
         engine.prepass = Some(Prepass::new(ctx)?);
         engine.composite = Some(Composite::new(ctx, COLOR_FORMAT)?);
+        engine.import = Some(Import::new(ctx)?);
         let size = std::mem::size_of::<FrameGlobals>() as u64;
-        engine.globals =
+        engine.data.globals =
             Some(PerFrame::new(ctx, "frame globals", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?);
         Ok(engine)
     }
@@ -285,11 +306,14 @@ impl Engine {
         }
     }
 
-    /// Waits for every frame in flight, so that their timings are available.
+    /// Waits for every frame in flight, so that their timings are available. On an engine that
+    /// records into the embedder's command buffers, call it only once the embedder has waited
+    /// for its frames (their fences are the embedder's).
     pub fn flush(&mut self) -> Result<()> {
         let frames = self.frames.as_mut().expect("engine is built");
         let done = frames.drain(&self.ctx)?;
         self.push_timings(done);
+        self.release_staging();
         Ok(())
     }
 
@@ -299,6 +323,13 @@ impl Engine {
         self.destroy_resources();
         self.ctx.destroy();
         self.ctx.validation_errors()
+    }
+
+    /// Every frame begun has finished: their uploads' staging buffers can go.
+    fn release_staging(&mut self) {
+        if let Some(last) = self.data.number.checked_sub(1) {
+            self.data.meshes.release_staging(&self.ctx, last);
+        }
     }
 
     fn push_timings(&mut self, done: impl IntoIterator<Item = Vec<PassTime>>) {
@@ -339,87 +370,13 @@ impl Engine {
                 return Ok(None);
             }
         }
-        let number = self.frame_number;
-        self.frame_number += 1;
-        // The fence just waited on covers every frame up to `number - FRAMES_IN_FLIGHT`.
-        if let Some(completed) = number.checked_sub(FRAMES_IN_FLIGHT as u64) {
-            self.meshes.evict(ctx, completed);
-        }
-
-        // Draw list: the scene's objects, then the ground.
-        let mut objects = Vec::with_capacity(scene.objects.len() + 1);
-        let mut draws = Vec::with_capacity(scene.objects.len() + 1);
-        for o in &scene.objects {
-            let model = o.transform.matrix();
-            let bounds = o.mesh.bounds.transformed(&model);
-            let instance = objects.len() as u32;
-            draws.push(self.meshes.draw(ctx, &o.mesh, number, instance, bounds, (o.casts, o.receives))?);
-            objects.push(object_data(
-                model,
-                Mat4::from_mat3(o.normal_matrix()),
-                o.color,
-                ShadowRole::new(o.receives, o.casts),
-            ));
-        }
-        if let Some(g) = &scene.ground {
-            let model = ground_model(g);
-            let instance = objects.len() as u32;
-            draws.push(self.meshes.draw(ctx, &self.ground_mesh, number, instance, g.bounds(), (false, true))?);
-            objects.push(object_data(model, Mat4::IDENTITY, GROUND_COLOR, ShadowRole::Receives));
-        }
-        let bytes: &[u8] = cast_slice(&objects);
-        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-        let object_buffer = PerFrame::ensure(ctx, &mut self.objects, "objects", bytes.len() as u64, usage)?;
-        if !bytes.is_empty() {
-            object_buffer.write(frame.slot, bytes);
-        }
-
-        let aspect = w as f32 / h as f32;
-        let cam = &scene.camera;
-        let scene_bounds = draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
-        let camera = CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, aspect, &scene_bounds);
-        let globals = FrameGlobals {
-            view_proj: camera.view_proj,
-            inv_view_proj: camera.inv_view_proj,
-            camera_position: cam.position.extend(1.0),
-            camera_forward: camera.forward.extend(0.0),
-            light: scene.light.position.extend(scene.light.radius),
-            light_color: Vec4::ONE,
-            ambient: Vec4::splat(AMBIENT),
-            sky: Vec3::from(SKY).extend(1.0),
-            viewport: Vec4::new(w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32),
-        };
-        let globals_buffer = self.globals.as_mut().expect("engine is built");
-        globals_buffer.write(frame.slot, bytes_of(&globals));
-        let globals_range = globals_buffer.range(frame.slot);
-        let objects_range = object_buffer.range(frame.slot);
-        let receivers = receivers_in_view(&camera.frustum, &draws);
-
+        let prepared = self.data.prepare(ctx, &frame, scene, None, vk::Extent2D { width: w, height: h })?;
         clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
-        self.prepass.as_ref().expect("built").record(
-            ctx,
-            &mut frame,
-            targets,
-            [globals_range, objects_range],
-            &draws,
-        )?;
+        self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, prepared.inputs(), &prepared.draws)?;
         clock.mark("prepass");
         let (_, technique) = self.technique.as_mut().expect("ensured");
-        let mut inputs = FrameInputs {
-            ctx,
-            cmd: frame.cmd,
-            slot: frame.slot,
-            timer: &mut *frame.timer,
-            scene,
-            camera: &camera,
-            globals: globals_range,
-            objects: objects_range,
-            draws: &draws,
-            depth: &targets.depth,
-            normal: &targets.normal,
-            receivers_in_view: &receivers,
-        };
+        let mut inputs = prepared.frame_inputs(ctx, &mut frame, scene, &targets.depth, &targets.normal);
         technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
         clock.mark("technique");
         let (composite, into) = match window.as_deref_mut() {
@@ -429,7 +386,7 @@ impl Engine {
             }
             None => (self.composite.as_ref().expect("built"), None),
         };
-        composite.record(ctx, &mut frame, targets, into, globals_range)?;
+        composite.record(ctx, &mut frame, targets, into, prepared.globals)?;
         if capture {
             let size = capture::readback_size(w, h, self.visibility_format);
             if self.readback.as_ref().is_none_or(|b| b.size != size) {
@@ -465,6 +422,7 @@ impl Engine {
         };
         let frames = self.frames.as_mut().expect("engine is built");
         frames.submit(ctx, slot, &crate::gpu::Semaphores { wait: &wait, signal: &signal })?;
+        self.data.meshes.commit();
         clock.mark(SUBMIT);
         if let Some(w) = window {
             w.present(ctx)?;
@@ -495,8 +453,9 @@ impl Engine {
             bar.finish_and_clear();
         }
         clock.mark("wait for GPU");
+        self.release_staging();
         let readback = self.readback.as_ref().expect("ensured");
-        let mut capture = Capture::read(readback, w, h, &camera, self.visibility_format);
+        let mut capture = Capture::read(readback, w, h, &prepared.camera, self.visibility_format);
         if let Some((_, t)) = &self.technique
             && let Some(surfaces) = t.traced_surfaces()
         {
@@ -506,6 +465,86 @@ impl Engine {
         self.cpu_spans.push_back(clock.spans);
         self.push_timings(done);
         Ok(Some(capture))
+    }
+
+    /// Records a frame into the embedder's command buffer (DESIGN.md §3 "Embedding"): the
+    /// embedder's camera and depth (and normals) imported (see [`EmbeddedFrame`] for how
+    /// receivers and casters are told apart), then the technique of `params` for `scene`'s
+    /// casters and light (its camera is not used), writing V into `frame.visibility` or the
+    /// engine's own target. Neither submits nor waits: the embedder submits `frame.cmd`.
+    ///
+    /// The embedder keeps at most [`FRAMES_IN_FLIGHT`] recorded frames unfinished: before
+    /// recording frame n it has waited for frame n − 2 to finish (an error says so otherwise),
+    /// and it submits every frame it records. Pass times arrive in [`Engine::take_timings`] as
+    /// soon as a later `record` finds them written: one frame late when the GPU keeps up. A
+    /// change of size or technique since the last frame waits for the queue once
+    /// (`vkQueueWaitIdle`). On an error the command buffer may hold part of the frame: reset it.
+    /// Offline CPU techniques (`raytrace`, `parker`) cannot record and are refused.
+    pub fn record(&mut self, scene: &Scene, params: &Params, frame: &EmbeddedFrame) -> Result<Recorded> {
+        scene.validate()?;
+        frame.check(self.visibility_format)?;
+        let info = params.technique;
+        if info.kind.offline() && info.kind != technique::Kind::GroundTruth(technique::Runs::Gpu) {
+            return Err(Error::Invalid(format!(
+                "technique {} runs on the CPU: it cannot record into a command buffer",
+                info.name
+            )));
+        }
+        let camera = &frame.camera;
+        let projection =
+            CameraProjection::from_matrices(camera.view, camera.projection, camera.reverse_z, camera.near, camera.far)
+                .map_err(Error::Invalid)?;
+        let extent = frame.depth.extent;
+        self.ensure_targets(extent.width, extent.height)?;
+        self.ensure_technique(info)?;
+
+        let ctx = &self.ctx;
+        let frames = self.frames.as_mut().expect("engine is built");
+        let mut clock = SpanClock::start();
+        let (mut gpu_frame, earlier) = frames.begin_external(ctx, frame.cmd)?;
+        clock.mark(WAIT_FOR_SLOT);
+        let slot = gpu_frame.slot;
+        // The slot's last frame has finished: the views made for it can go.
+        std::mem::take(&mut self.wrapped[slot]).into_iter().for_each(|t| t.destroy(ctx));
+        let mut images = Wrapped::new(ctx, frame)?;
+        let mut record = || -> Result<Recorded> {
+            let prepared = self.data.prepare(ctx, &gpu_frame, scene, Some(projection), extent)?;
+            clock.mark("draw list");
+            let targets = self.targets.as_mut().expect("ensured");
+            let import = ImportTargets {
+                depth: &mut targets.depth,
+                normal: &mut targets.normal,
+                embedder_depth: &mut images.depth,
+                embedder_normal: images.normal.as_mut(),
+            };
+            let pass = self.import.as_mut().expect("built");
+            pass.record(ctx, &mut gpu_frame, import, camera.reverse_z, prepared.inputs(), &prepared.draws)?;
+            clock.mark("import");
+            let visibility = images.visibility.as_mut().unwrap_or(&mut targets.visibility);
+            let (_, technique) = self.technique.as_mut().expect("ensured");
+            let mut inputs = prepared.frame_inputs(ctx, &mut gpu_frame, scene, &targets.depth, &targets.normal);
+            technique.record(&mut inputs, params, visibility)?;
+            // Ready for the embedder's shading to sample.
+            transition(ctx, frame.cmd, &mut [(&mut *visibility, Access::FRAGMENT_READ, false)]);
+            clock.mark("technique");
+            Ok(Recorded {
+                depth: images.depth.last_access(),
+                normal: images.normal.as_ref().map(Target::last_access),
+                visibility: visibility.last_access(),
+                visibility_image: visibility.image(),
+                visibility_view: visibility.view(),
+            })
+        };
+        let recorded = record();
+        // Kept until the slot comes round again, on success or not (a failed frame's command
+        // buffer may still refer to them until the embedder resets it).
+        self.wrapped[slot] = images.into_targets();
+        let recorded = recorded?;
+        self.frames.as_mut().expect("engine is built").end_external(ctx, slot, frame.cmd);
+        self.data.meshes.commit();
+        self.push_timings(earlier);
+        self.cpu_spans.push_back(clock.spans);
+        Ok(recorded)
     }
 
     fn ensure_targets(&mut self, w: u32, h: u32) -> Result<()> {
@@ -539,12 +578,14 @@ impl Engine {
         if let Some((_, t)) = self.technique.take() {
             t.destroy(ctx);
         }
-        std::mem::take(&mut self.meshes).destroy(ctx);
+        std::mem::take(&mut self.data.meshes).destroy(ctx);
+        self.wrapped.iter_mut().flat_map(std::mem::take).for_each(|t| t.destroy(ctx));
         self.targets.take().into_iter().for_each(|t| t.destroy(ctx));
         self.readback.take().into_iter().for_each(|b| b.destroy(ctx));
         self.window.take().into_iter().for_each(|w| w.destroy(ctx));
-        self.globals.take().into_iter().chain(self.objects.take()).for_each(|b| b.destroy(ctx));
+        self.data.globals.take().into_iter().chain(self.data.objects.take()).for_each(|b| b.destroy(ctx));
         self.prepass.take().into_iter().for_each(|p| p.destroy(ctx));
+        self.import.take().into_iter().for_each(|p| p.destroy(ctx));
         self.composite.take().into_iter().for_each(|p| p.destroy(ctx));
         self.frames.take().into_iter().for_each(|f| f.destroy(ctx));
     }
@@ -554,32 +595,4 @@ impl Drop for Engine {
     fn drop(&mut self) {
         self.destroy_resources();
     }
-}
-
-fn object_data(model: Mat4, normal: Mat4, color: Vec3, role: ShadowRole) -> ObjectData {
-    ObjectData { model, normal_matrix: normal, albedo: color.extend(role.encode()) }
-}
-
-/// The ground is the unit plate scaled to the ground's square, at its height.
-fn ground_model(g: &Ground) -> Mat4 {
-    let side = 2.0 * g.half_size;
-    Mat4::from_scale_rotation_translation(
-        Vec3::new(side, 1.0, side),
-        glam::Quat::IDENTITY,
-        Vec3::new(0.0, g.height, 0.0),
-    )
-}
-
-/// Points spanning the visible part of every receiver: each receiver's box clipped by the
-/// camera frustum. Flat receivers are thickened by a hair so clipping keeps them.
-fn receivers_in_view(frustum: &Hexahedron, draws: &[Draw]) -> Vec<Vec3> {
-    draws
-        .iter()
-        .filter(|d| d.receives)
-        .flat_map(|d| {
-            let pad = Vec3::splat(1e-4 * (d.bounds.max - d.bounds.min).max_element().max(f32::MIN_POSITIVE));
-            let grown = Aabb { min: d.bounds.min - pad, max: d.bounds.max + pad };
-            intersection_points(frustum, &Hexahedron { corners: grown.corners() })
-        })
-        .collect()
 }
