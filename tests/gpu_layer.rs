@@ -2,16 +2,16 @@
 //! the embedder's handles, wrapped images, depth-stencil targets and semaphore submissions. Every
 //! test runs with validation on and fails on any validation error, leaks included.
 
-use std::ffi::{CStr, c_void};
-use std::sync::Mutex;
+mod common;
 
 use ash::vk;
+use common::embedder::Embedder;
 use gpu_allocator::MemoryLocation;
 use softshadow::Error;
 use softshadow::gpu::{
-    Access, Attachment, Buffer, Context, ContextOptions, DeviceFilter, EmbedderHandles, FrameRing, Ownership,
-    RenderPass, Semaphores, Target, TargetDesc, copy_to_buffer, copy_to_host, required_core_features,
-    required_device_extensions, required_vulkan13_features, transition,
+    Access, Attachment, Buffer, Context, ContextOptions, DeviceFilter, FrameRing, Ownership, RenderPass, Semaphores,
+    Target, TargetDesc, copy_to_buffer, copy_to_host, required_device_extensions, required_vulkan13_features,
+    transition,
 };
 
 const SIDE: u32 = 4;
@@ -230,125 +230,12 @@ fn a_frame_waits_on_the_semaphore_another_signals() {
     finish(ctx);
 }
 
-/// Validation messages of the test's own instance, as an embedder's messenger records them.
-#[derive(Default)]
-struct Log(Mutex<Vec<String>>);
-
-unsafe extern "system" fn record(
-    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
-    _: vk::DebugUtilsMessageTypeFlagsEXT,
-    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
-    user: *mut c_void,
-) -> vk::Bool32 {
-    // SAFETY: the layer passes valid data; `user` is the boxed log, alive until the instance goes.
-    let (message, log) = unsafe { ((*data).message_as_c_str().unwrap_or_default(), &*(user as *const Log)) };
-    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-        log.0.lock().unwrap().push(message.to_string_lossy().into_owned());
-    }
-    vk::FALSE
-}
-
-/// An embedder's instance (with validation and a messenger of its own) and device.
-struct Embedder {
-    entry: ash::Entry,
-    instance: ash::Instance,
-    messenger: (ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT),
-    physical: vk::PhysicalDevice,
-    queue_family: u32,
-    log: Box<Log>,
-}
-
-impl Embedder {
-    fn new() -> Self {
-        let entry = unsafe { ash::Entry::load() }.expect("a Vulkan loader");
-        let log = Box::<Log>::default();
-        let messenger_ci = || {
-            vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR)
-                .message_type(
-                    vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION | vk::DebugUtilsMessageTypeFlagsEXT::GENERAL,
-                )
-                .pfn_user_callback(Some(record))
-                .user_data(&*log as *const Log as *mut c_void)
-        };
-        let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_3);
-        let layers = [c"VK_LAYER_KHRONOS_validation".as_ptr()];
-        let extensions = [ash::ext::debug_utils::NAME.as_ptr(), ash::ext::validation_features::NAME.as_ptr()];
-        let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
-        let mut instance_messenger = messenger_ci();
-        let instance_ci = vk::InstanceCreateInfo::default()
-            .application_info(&app)
-            .enabled_layer_names(&layers)
-            .enabled_extension_names(&extensions)
-            .push_next(&mut features)
-            .push_next(&mut instance_messenger);
-        let instance = unsafe { entry.create_instance(&instance_ci, None) }.expect("an instance with validation");
-        let loader = ash::ext::debug_utils::Instance::new(&entry, &instance);
-        let messenger = unsafe { loader.create_debug_utils_messenger(&messenger_ci(), None) }.unwrap();
-        let (physical, queue_family) = unsafe { instance.enumerate_physical_devices() }
-            .unwrap()
-            .into_iter()
-            .filter(|&p| unsafe { instance.get_physical_device_properties(p) }.api_version >= vk::API_VERSION_1_3)
-            .find_map(|p| {
-                let families = unsafe { instance.get_physical_device_queue_family_properties(p) };
-                let family = families.iter().position(|f| {
-                    f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-                        && f.timestamp_valid_bits > 0
-                })?;
-                Some((p, family as u32))
-            })
-            .expect("a Vulkan 1.3 device");
-        Embedder { entry, instance, messenger: (loader, messenger), physical, queue_family, log }
-    }
-
-    fn device(&self, extensions: &[&CStr]) -> ash::Device {
-        let priorities = [1.0];
-        let queue_ci =
-            [vk::DeviceQueueCreateInfo::default().queue_family_index(self.queue_family).queue_priorities(&priorities)];
-        let names: Vec<_> = extensions.iter().map(|e| e.as_ptr()).collect();
-        let mut v13 = required_vulkan13_features();
-        let core = required_core_features();
-        let ci = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&queue_ci)
-            .enabled_extension_names(&names)
-            .enabled_features(&core)
-            .push_next(&mut v13);
-        unsafe { self.instance.create_device(self.physical, &ci, None) }.unwrap()
-    }
-
-    fn handles(&self, device: &ash::Device) -> EmbedderHandles {
-        EmbedderHandles {
-            entry: self.entry.clone(),
-            instance: self.instance.clone(),
-            physical_device: self.physical,
-            device: device.clone(),
-            queue_family: self.queue_family,
-            queue_index: 0,
-            enabled_features: required_vulkan13_features(),
-            enabled_core_features: required_core_features(),
-        }
-    }
-
-    /// Destroys the device and then the instance, and fails on any validation error.
-    fn finish(self, device: ash::Device) {
-        unsafe {
-            device.destroy_device(None);
-            self.messenger.0.destroy_debug_utils_messenger(self.messenger.1, None);
-            self.instance.destroy_instance(None);
-        }
-        let errors = self.log.0.lock().unwrap().clone();
-        assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
-    }
-}
-
 /// The context renders on the embedder's device and leaves it, and the instance, alive: the
 /// embedder destroys them afterwards without a double destroy or a leak report.
 #[test]
 fn a_context_on_the_embedders_device_renders_and_destroys_only_its_own() {
-    let embedder = Embedder::new();
-    let device = embedder.device(required_device_extensions());
-    let mut ctx = unsafe { Context::from_handles(embedder.handles(&device)) }.unwrap();
+    let embedder = Embedder::new(required_device_extensions(), required_vulkan13_features());
+    let mut ctx = unsafe { Context::from_handles(embedder.handles(required_vulkan13_features())) }.unwrap();
     assert_eq!(ctx.ownership(), Ownership::Borrowed);
     let desc = TargetDesc::color("embedded", RGBA8, SIDE, SIDE).usage(vk::ImageUsageFlags::TRANSFER_SRC);
     let mut target = Target::new(&ctx, desc).unwrap();
@@ -366,23 +253,21 @@ fn a_context_on_the_embedders_device_renders_and_destroys_only_its_own() {
     ctx.destroy();
     assert!(ctx.validation_errors().is_empty());
     drop(ctx);
-    embedder.finish(device);
+    embedder.finish();
 }
 
 #[test]
 fn an_embedders_device_without_what_we_need_is_refused_by_name() {
-    let embedder = Embedder::new();
-    let device = embedder.device(&[]);
-    let why =
-        unsafe { Context::from_handles(embedder.handles(&device)) }.err().expect("no push descriptors").to_string();
+    let embedder = Embedder::new(&[], required_vulkan13_features());
+    let why = unsafe { Context::from_handles(embedder.handles(required_vulkan13_features())) }
+        .err()
+        .expect("no push descriptors")
+        .to_string();
     assert!(why.contains("VK_KHR_push_descriptor"), "{why}");
-    let handles = EmbedderHandles {
-        enabled_features: required_vulkan13_features().synchronization2(false),
-        ..embedder.handles(&device)
-    };
+    let handles = embedder.handles(required_vulkan13_features().synchronization2(false));
     let why = unsafe { Context::from_handles(handles) }.err().expect("no synchronization2").to_string();
     assert!(why.contains("synchronization2"), "{why}");
-    embedder.finish(device);
+    embedder.finish();
 }
 
 /// The pipeline state the shadow volumes need, on a depth-stencil target: full-screen triangles
