@@ -10,12 +10,13 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The folder cargo put `libsoftshadow.so` in: the test binary's `deps/` sits inside it.
+/// The folder cargo put `libsoftshadow.so` in: `cargo test` leaves it in `deps/`, beside the
+/// test binary; `cargo build` also copies it to the folder above.
 fn library_dir() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().and_then(Path::parent).unwrap().to_path_buf();
-    assert!(dir.join("libsoftshadow.so").exists(), "no libsoftshadow.so in {}", dir.display());
-    dir
+    let deps = exe.parent().unwrap();
+    let found = [deps, deps.parent().unwrap()].into_iter().find(|d| d.join("libsoftshadow.so").exists());
+    found.unwrap_or_else(|| panic!("no libsoftshadow.so in {} or its parent", deps.display())).to_path_buf()
 }
 
 fn generated_header() -> String {
