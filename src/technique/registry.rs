@@ -121,11 +121,6 @@ pub fn ground_truth(runs: Runs) -> &'static TechniqueInfo {
     TECHNIQUES.iter().copied().find(|t| t.kind == Kind::GroundTruth(runs)).expect("the registry lists both truths")
 }
 
-/// The techniques of a kind, in registry order.
-pub fn of_kind(kind: Kind) -> impl Iterator<Item = &'static TechniqueInfo> {
-    TECHNIQUES.iter().copied().filter(move |t| t.kind == kind)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
