@@ -1,4 +1,5 @@
-// The falloff curves of src/technique/falloff.rs: row 0 linear, 1 sine, 2 smoothstep, 256
+// The falloff curves of src/technique/falloff.rs: row 0 linear, 1 sine, 2 smoothstep, 3 disk
+// edge, 256
 // entries each, read with interpolation (the sampler is nearest).
 #ifndef SOFTSHADOW_FALLOFF_GLSL
 #define SOFTSHADOW_FALLOFF_GLSL
