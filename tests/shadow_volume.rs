@@ -45,6 +45,45 @@ fn dark_pixels(c: &Capture) -> usize {
 const ZPASS: &[(&str, &str)] = &[("counting", "1")];
 const ZFAIL: &[(&str, &str)] = &[("counting", "2")];
 
+/// A perspective camera under a wide roof, the light above it: the eye is inside the roof's
+/// volume.
+fn camera_under_a_roof() -> softshadow::scene::Scene {
+    scene(
+        "[camera]\nposition = [0.0, 1.0, 0.0]\ntarget = [4.0, 0.0, 0.0]\nfov_y_deg = 60.0\n\
+         [light]\nposition = [0.0, 8.0, 0.0]\nradius = 0.0\n[ground]\nheight = 0.0\nhalf_size = 10.0\n\
+         [[object]]\nshape = \"plate\"\nsize = [4.0, 0.0, 4.0]\nposition = [0.0, 2.0, 0.0]\n",
+    )
+}
+
+/// The bottomless cube (models/cube_no_bottom.obj) lit from above and from under its open
+/// side, and a cube with a fin on one edge (three faces there), seen from above; the fin's OBJ
+/// is written into `dir`.
+fn open_and_non_manifold(dir: &std::path::Path) -> Vec<(String, softshadow::scene::Scene)> {
+    let fin = dir.join("fin.obj");
+    std::fs::write(
+        &fin,
+        "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\nv -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\n\
+         v 0.5 0.5 0.5\nv -0.5 0.5 0.5\nv -0.5 1.0 0.5\nv 0.5 1.0 0.5\n\
+         f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\nf 4 8 7\nf 4 7 3\nf 1 2 6\nf 1 6 5\n\
+         f 8 7 10\nf 8 10 9\n",
+    )
+    .unwrap();
+    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube_no_bottom.obj");
+    [(models, [2.0, 5.0, 1.0]), (models, [0.6, 0.3, 0.2]), (fin.to_str().unwrap(), [1.5, 4.0, -2.5])]
+        .into_iter()
+        .map(|(mesh, light)| {
+            let object = format!("[[object]]\nshape = \"mesh\"\nmesh = \"{mesh}\"\nposition = [0.0, 1.2, 0.0]\n");
+            (format!("{mesh} {light:?}"), top_down(0.0, 3.0, light, 0.0, &object))
+        })
+        .collect()
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("softshadow-volumes-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// Under a point light both counting rules give the shadow map's hard shadow (and the ray
 /// tracer's) except in a one-pixel band at the edges, on suite scenes with meshes, plates and
 /// spheres.
@@ -85,16 +124,11 @@ fn a_grazing_light_shows_no_acne_or_peter_panning() {
     finish(e);
 }
 
-/// A perspective camera under a wide roof, the light above it: the eye is inside the roof's
-/// volume. z-pass starts counting at 0 instead of 1 and inverts the shadow; z-fail, and the
-/// engine's automatic choice, do not.
+/// A camera inside a shadow volume ([`camera_under_a_roof`]): z-pass starts counting at 0
+/// instead of 1 and inverts the shadow; z-fail, and the engine's automatic choice, do not.
 #[test]
 fn a_camera_inside_a_shadow_volume_breaks_z_pass_not_z_fail() {
-    let s = scene(
-        "[camera]\nposition = [0.0, 1.0, 0.0]\ntarget = [4.0, 0.0, 0.0]\nfov_y_deg = 60.0\n\
-         [light]\nposition = [0.0, 8.0, 0.0]\nradius = 0.0\n[ground]\nheight = 0.0\nhalf_size = 10.0\n\
-         [[object]]\nshape = \"plate\"\nsize = [4.0, 0.0, 4.0]\nposition = [0.0, 2.0, 0.0]\n",
-    );
+    let s = camera_under_a_roof();
     let mut e = engine();
     let ray = render_with(&mut e, &s, "raytrace", &[], 64);
     assert!(dark_pixels(&ray) > 100 && dark_pixels(&ray) < 64 * 64 - 100, "shadow and light in view");
@@ -137,10 +171,8 @@ fn a_near_plane_cutting_a_volume_breaks_neither_rule() {
     finish(e);
 }
 
-/// 256 thin boxes stacked over one spot: 256 volumes hold the ground under them, a count of
-/// 0 in 8 bits. Groups of at most 127 keep it whole.
-#[test]
-fn counts_beyond_the_stencils_bits_stay_shadowed() {
+/// 256 thin boxes stacked over one spot, seen from above.
+fn stacked_boxes() -> softshadow::scene::Scene {
     let boxes: String = (0..256)
         .map(|k| {
             format!(
@@ -149,7 +181,14 @@ fn counts_beyond_the_stencils_bits_stay_shadowed() {
             )
         })
         .collect();
-    let s = top_down(0.0, 2.0, [0.0, 8.0, 0.0], 0.0, &boxes);
+    top_down(0.0, 2.0, [0.0, 8.0, 0.0], 0.0, &boxes)
+}
+
+/// [`stacked_boxes`]: 256 volumes hold the ground under them, a count of 0 in 8 bits. Groups
+/// of at most 127 keep it whole.
+#[test]
+fn counts_beyond_the_stencils_bits_stay_shadowed() {
+    let s = stacked_boxes();
     let mut e = engine();
     for sets in [ZPASS, ZFAIL] {
         let v = render_with(&mut e, &s, "shadow-volume", sets, 64);
@@ -201,36 +240,51 @@ fn scene_scales_from_a_millimetre_to_ten_kilometres() {
     finish(e);
 }
 
-/// The bottomless cube (models/cube_no_bottom.obj) and a cube with a fin on one edge (three
-/// faces there): boundary and non-manifold edges, every triangle blocking from its lit side.
-/// Seen from above with the light below the open side, only the inside faces block.
+/// [`open_and_non_manifold`] meshes: boundary and non-manifold edges, every triangle
+/// blocking from its lit side. With the light below the open side, only the inside faces block.
 #[test]
 fn open_and_non_manifold_meshes() {
-    let dir = std::env::temp_dir().join(format!("softshadow-volumes-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let fin = dir.join("fin.obj");
-    std::fs::write(
-        &fin,
-        "v -0.5 -0.5 -0.5\nv 0.5 -0.5 -0.5\nv 0.5 0.5 -0.5\nv -0.5 0.5 -0.5\nv -0.5 -0.5 0.5\nv 0.5 -0.5 0.5\n\
-         v 0.5 0.5 0.5\nv -0.5 0.5 0.5\nv -0.5 1.0 0.5\nv 0.5 1.0 0.5\n\
-         f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 8\nf 1 5 8\nf 1 8 4\nf 2 3 7\nf 2 7 6\nf 4 8 7\nf 4 7 3\nf 1 2 6\nf 1 6 5\n\
-         f 8 7 10\nf 8 10 9\n",
-    )
-    .unwrap();
-    let models = concat!(env!("CARGO_MANIFEST_DIR"), "/models/cube_no_bottom.obj");
+    let dir = scratch("open");
     let mut e = engine();
-    for (mesh, light) in
-        [(models, [2.0, 5.0, 1.0]), (models, [0.6, 0.3, 0.2]), (fin.to_str().unwrap(), [1.5, 4.0, -2.5])]
-    {
-        let object = format!("[[object]]\nshape = \"mesh\"\nmesh = \"{mesh}\"\nposition = [0.0, 1.2, 0.0]\n");
-        let s = top_down(0.0, 3.0, light, 0.0, &object);
+    for (what, s) in open_and_non_manifold(&dir) {
         let adjacency = &s.objects[0].mesh.adjacency;
-        assert!(adjacency.boundary + adjacency.non_manifold > 0, "{mesh} is open or non-manifold");
+        assert!(adjacency.boundary + adjacency.non_manifold > 0, "{what} is open or non-manifold");
         let ray = render_with(&mut e, &s, "raytrace", &[], 64);
-        assert!(dark_pixels(&ray) > 50, "{mesh}: a shadow");
+        assert!(dark_pixels(&ray) > 50, "{what}: a shadow");
         for sets in [ZPASS, ZFAIL] {
             let v = render_with(&mut e, &s, "shadow-volume", sets, 64);
-            assert_same_hard_shadow(&v, &ray, &format!("{mesh} {light:?} {sets:?}"));
+            assert_same_hard_shadow(&v, &ray, &format!("{what} {sets:?}"));
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    finish(e);
+}
+
+/// The volumes built by the compute pass (`gpu_silhouettes = 1`) count as the CPU's do: V the
+/// same to 1/255 everywhere, on the scenes above (suite meshes, open and non-manifold meshes,
+/// the eye in a volume, counts beyond the stencil's bits in groups), both counting rules, and
+/// accumulated from 16 points.
+#[test]
+fn volumes_built_on_the_gpu_count_as_the_cpus() {
+    let dir = scratch("gpu");
+    let mut scenes = open_and_non_manifold(&dir);
+    for name in ["default", "two_boxes", "torus"] {
+        let mut s = suite_scene(name);
+        s.light.radius = 0.0;
+        scenes.push((name.to_string(), s));
+    }
+    scenes.push(("the eye in a volume".to_string(), camera_under_a_roof()));
+    scenes.push(("256 stacked boxes".to_string(), stacked_boxes()));
+    let soft = [("samples", "16")];
+    let mut e = engine();
+    for (what, s) in &scenes {
+        for sets in [ZPASS, ZFAIL, &soft[..]] {
+            let cpu = render_with(&mut e, s, "shadow-volume", sets, 64);
+            let gpu_sets: Vec<_> = sets.iter().copied().chain([("gpu_silhouettes", "1")]).collect();
+            let gpu = render_with(&mut e, s, "shadow-volume", &gpu_sets, 64);
+            let worst = cpu.visibility.iter().zip(&gpu.visibility).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+            assert!(worst <= 65535 / 255, "{what} {sets:?}: V differs by {:.4}", worst as f64 / 65535.0);
+            assert!(dark_pixels(&cpu) > 0, "{what}: a shadow to compare");
         }
     }
     std::fs::remove_dir_all(&dir).ok();
@@ -253,6 +307,40 @@ fn accumulation_converges_to_the_truth() {
             .collect();
         assert!(rmse[2] < rmse[1] && rmse[1] < rmse[0], "{technique}: {rmse:?}");
         assert!(rmse[0] > 0.15 && rmse[1] < 0.05 && rmse[2] < 0.017, "{technique}: {rmse:?}");
+    }
+    finish(e);
+}
+
+/// The timings name the papers' passes: the GPU path times its `silhouettes` compute pass
+/// apart from the stencil fill (`volumes`, `caps`), the CPU path reports its silhouette work as
+/// a CPU span of that name, taken out of the `technique` span, not added to it.
+#[test]
+fn silhouettes_are_timed_apart_from_the_fill() {
+    let mut s = suite_scene("two_boxes");
+    s.light.radius = 0.0;
+    let mut e = engine();
+    for (gpu, counting) in [("0", "2"), ("1", "2"), ("1", "1")] {
+        let sets = [("gpu_silhouettes", gpu), ("counting", counting)];
+        for _ in 0..2 {
+            render_with(&mut e, &s, "shadow-volume", &sets, 64);
+        }
+        e.flush().unwrap();
+        let t = e.take_timings().pop().unwrap();
+        let passes: Vec<_> = t.passes.iter().map(|p| p.name).collect();
+        let mut expected = vec!["prepass", "volumes", "caps", "accumulate", "resolve", "composite"];
+        if counting == "1" {
+            expected.retain(|p| *p != "caps");
+        }
+        if gpu == "1" {
+            expected.insert(1, "silhouettes");
+        }
+        assert_eq!(passes, expected, "{sets:?}");
+        assert!(t.passes.iter().all(|p| p.ms > 0.0 && p.ms.is_finite()), "{t:?}");
+        let cpu: Vec<_> = t.cpu.iter().map(|c| c.name).collect();
+        let at = cpu.iter().position(|n| *n == "technique").expect("a technique span");
+        assert_eq!(cpu[at - 1] == "silhouettes", gpu == "0", "{sets:?}: {cpu:?}");
+        assert_eq!(cpu.iter().filter(|n| **n == "silhouettes").count(), (gpu == "0") as usize, "{cpu:?}");
+        assert!(t.cpu.iter().all(|c| c.ms >= 0.0), "{t:?}");
     }
     finish(e);
 }

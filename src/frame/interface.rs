@@ -76,6 +76,24 @@ pub struct SilhouetteParams {
     pub pad: [Vec4; 10],
 }
 
+/// One caster's shadow volume from one light point, built on the GPU, padded to 256 bytes
+/// (see `LightSample`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct VolumeParams {
+    pub model: Mat4,
+    pub light: Vec4,
+    /// Edges, triangles, 1 for the two-sided construction, the object's index.
+    pub counts: [u32; 4],
+    /// Where the mesh data's triangles and edges begin (positions come first).
+    pub offsets: [u32; 4],
+    /// The indirect draw commands of the sides, the caps and the turned caps.
+    pub commands: [u32; 4],
+    /// The vertex where each of those ranges ends.
+    pub ends: [u32; 4],
+    pub pad: [Vec4; 7],
+}
+
 /// One hard shadow of an accumulation, padded to 256 bytes (see `LightSample`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -128,6 +146,7 @@ const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
 const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
 const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);
 const _: () = assert!(std::mem::size_of::<SampleView>() == 256);
+const _: () = assert!(std::mem::size_of::<VolumeParams>() == 256);
 const _: () = assert!(std::mem::size_of::<ClassicView>() == 6 * 16);
 const _: () = assert!(std::mem::size_of::<BlobData>() == 2 * 16);
 const _: () = assert!(std::mem::size_of::<CasterImage>() == 256);

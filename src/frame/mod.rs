@@ -128,6 +128,9 @@ pub struct FrameInputs<'a> {
     pub normal: &'a Target,
     /// Points whose hull is the receivers' visible part: no shadow matters outside it.
     pub receivers_in_view: &'a [Vec3],
+    /// CPU work of the technique's that the timings show apart, as (name, ms): the renderer
+    /// cuts it out of the frame's `technique` span.
+    pub cpu_spans: Vec<(&'static str, f64)>,
 }
 
 #[cfg(test)]

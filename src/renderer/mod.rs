@@ -69,8 +69,10 @@ impl FrameSettings {
 pub struct FrameTimings {
     pub passes: Vec<PassTime>,
     /// In order: [`WAIT_FOR_SLOT`], `acquire` (a presented frame), `draw list`, `prepass`,
-    /// `technique` (its per-frame geometry and recording), `composite`, [`SUBMIT`], `present` (a
-    /// presented frame); a captured frame adds `wait for GPU` and `readback`.
+    /// `technique` (its per-frame geometry and recording, less the parts it reports apart, such
+    /// as the shadow volumes' CPU `silhouettes`, which come just before it), `composite`,
+    /// [`SUBMIT`], `present` (a presented frame); a captured frame adds `wait for GPU` and
+    /// `readback`.
     pub cpu: Vec<CpuSpan>,
 }
 
@@ -119,6 +121,21 @@ impl SpanClock {
     fn mark(&mut self, name: &'static str) {
         let now = Instant::now();
         self.spans.push(CpuSpan { name, start: self.last, ms: (now - self.last).as_secs_f64() * 1e3 });
+        self.last = now;
+    }
+
+    /// Ends the span that began at the previous mark as `parts` (name, ms), laid end to end,
+    /// then `name` for the rest.
+    fn mark_split(&mut self, name: &'static str, parts: &[(&'static str, f64)]) {
+        let now = Instant::now();
+        let mut rest = (now - self.last).as_secs_f64() * 1e3;
+        for &(part, ms) in parts {
+            let ms = ms.min(rest);
+            self.spans.push(CpuSpan { name: part, start: self.last, ms });
+            self.last += std::time::Duration::from_secs_f64(ms * 1e-3);
+            rest -= ms;
+        }
+        self.spans.push(CpuSpan { name, start: self.last, ms: rest });
         self.last = now;
     }
 }
@@ -378,7 +395,7 @@ impl Engine {
         let (_, technique) = self.technique.as_mut().expect("ensured");
         let mut inputs = prepared.frame_inputs(ctx, &mut frame, scene, &targets.depth, &targets.normal);
         technique.record(&mut inputs, &settings.params, &mut targets.visibility)?;
-        clock.mark("technique");
+        clock.mark_split("technique", &inputs.cpu_spans);
         let (composite, into) = match window.as_deref_mut() {
             Some(w) => {
                 let (composite, image) = w.output();
@@ -526,7 +543,7 @@ impl Engine {
             technique.record(&mut inputs, params, visibility)?;
             // Ready for the embedder's shading to sample.
             transition(ctx, frame.cmd, &mut [(&mut *visibility, Access::FRAGMENT_READ, false)]);
-            clock.mark("technique");
+            clock.mark_split("technique", &inputs.cpu_spans);
             Ok(Recorded {
                 depth: images.depth.last_access(),
                 normal: images.normal.as_ref().map(Target::last_access),

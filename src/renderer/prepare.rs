@@ -154,6 +154,7 @@ impl Prepared {
             depth,
             normal,
             receivers_in_view: &self.receivers,
+            cpu_spans: Vec::new(),
         }
     }
 }

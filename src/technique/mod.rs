@@ -16,6 +16,7 @@ pub mod reference;
 pub mod registry;
 pub mod shadow_map;
 pub mod shadow_volume;
+mod shadow_volume_gpu;
 pub mod smoothie;
 mod smoothie_gpu;
 pub mod traced;

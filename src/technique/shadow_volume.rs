@@ -2,7 +2,8 @@
 //! "shadow volume"): exact hard shadows from a point, soft by accumulating N of them.
 //!
 //! Per light point, in the papers' order: `silhouettes` (on the CPU, the shared silhouette
-//! code, cached while nothing moves), `volumes` (the silhouette edges extruded to infinity,
+//! code, cached while nothing moves, a CPU span of the timings; or with `gpu_silhouettes` a
+//! compute pass, [`GpuVolumes`], a GPU one), `volumes` (the silhouette edges extruded to infinity,
 //! w = 0, counted by two-sided stencil in one pass), `caps` (z-fail only: the light caps, the
 //! caster's light-facing triangles, and the dark caps at infinity), then the stencil resolved
 //! into V: 0 is lit, anything else shadowed ([`Accumulation`]), and `resolve`.
@@ -33,6 +34,8 @@
 //! non-zero pixels marked in the top bit before the next group counts. One caster alone that
 //! could nest more than 127 times in itself is the one case left to the modulo.
 
+use std::time::Instant;
+
 use ash::vk;
 use bytemuck::cast_slice;
 use glam::{Mat4, Vec3, Vec4};
@@ -40,6 +43,7 @@ use glam::{Mat4, Vec3, Vec4};
 use super::accumulation::{Accumulation, SAMPLES, StencilRule, end_span, span, stencil};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::shadow_volume_gpu::{GpuVolumes, PARTS};
 use super::{Technique, clear_visibility};
 use crate::error::Result;
 use crate::frame::FrameInputs;
@@ -57,9 +61,9 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "shadow-volume",
     summary: "stencil shadow volumes: silhouettes extruded to infinity, z-pass or z-fail; N accumulated for soft",
     kind: Kind::Realtime,
-    knobs: &[SAMPLES, COUNTING],
+    knobs: &[SAMPLES, COUNTING, GPU_SILHOUETTES],
     create: |ctx, _, visibility| Ok(Box::new(ShadowVolumes::new(ctx, visibility)?)),
-    bench: &[&[], &[("counting", "2")], &[("samples", "16")]],
+    bench: &[&[], &[("counting", "2")], &[("gpu_silhouettes", "1")], &[("samples", "16")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
@@ -73,6 +77,15 @@ const COUNTING: Knob = Knob {
     max: 2.0,
     integer: true,
     help: "0: z-fail where a view ray can start in shadow, else z-pass; 1: z-pass; 2: z-fail",
+};
+
+const GPU_SILHOUETTES: Knob = Knob {
+    name: "gpu_silhouettes",
+    default: 0.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "1: silhouettes, volumes and caps built by a compute pass, drawn indirectly; 0: on the CPU",
 };
 
 /// The stencil bits that count; the top one marks the pixels an earlier group shadowed.
@@ -92,14 +105,16 @@ struct VolumeKey {
     points: Vec<Vec3>,
 }
 
-/// One group's vertex ranges in this frame's volume buffer.
-#[derive(Clone, Copy, Debug, Default)]
-struct GroupRange {
-    first: u32,
-    sides: u32,
-    caps: u32,
-    turned: u32,
+/// What a mesh's volumes need, found once: whether it takes the two-sided construction, and
+/// its nesting bound.
+#[derive(Clone, Copy, Debug)]
+struct MeshFacts {
+    two_sided: bool,
+    bound: u32,
 }
+
+/// One group's vertex ranges in this frame's volume buffer: first, then sides, caps, turned.
+type GroupRange = (u32, [u32; PARTS]);
 
 pub struct ShadowVolumes {
     depth_copy: Pipeline,
@@ -114,7 +129,9 @@ pub struct ShadowVolumes {
     depth_stencil: Option<Target>,
     /// Per scene object: its volumes, one per light point, and what they were built from.
     volumes: Vec<Option<(VolumeKey, Vec<ShadowVolume>)>>,
-    bounds: Vec<(MeshId, u32)>,
+    facts: Vec<(MeshId, MeshFacts)>,
+    /// Built on first use of `gpu_silhouettes`.
+    gpu: Option<GpuVolumes>,
 }
 
 impl ShadowVolumes {
@@ -170,14 +187,33 @@ impl ShadowVolumes {
             vertices: None,
             depth_stencil: None,
             volumes: Vec::new(),
-            bounds: Vec::new(),
+            facts: Vec::new(),
+            gpu: None,
         })
+    }
+
+    /// What every caster's mesh needs, found the first time it is seen.
+    fn learn_meshes(&mut self, frame: &FrameInputs<'_>) {
+        for o in frame.scene.objects.iter().filter(|o| o.casts) {
+            if self.facts.iter().any(|(id, _)| *id == o.mesh.id()) {
+                continue;
+            }
+            let m = &o.mesh;
+            let caster = Caster { positions: &m.positions, triangles: &m.triangles, adjacency: &m.adjacency };
+            let two_sided = is_open(&caster);
+            self.facts.push((m.id(), MeshFacts { two_sided, bound: nesting_bound(&caster, two_sided) }));
+        }
+    }
+
+    fn facts_of(&self, mesh: MeshId) -> MeshFacts {
+        self.facts.iter().find(|(id, _)| *id == mesh).expect("learnt every caster's mesh").1
     }
 
     /// Every caster's volumes from every point, rebuilt only for casters or lights that moved.
     fn build(&mut self, frame: &FrameInputs<'_>, points: &[Vec3]) {
         let objects = &frame.scene.objects;
         self.volumes.resize_with(objects.len(), || None);
+        let facts = &self.facts;
         for (o, cached) in objects.iter().zip(&mut self.volumes) {
             if !o.casts {
                 *cached = None;
@@ -190,10 +226,7 @@ impl ShadowVolumes {
             }
             let positions: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
             let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            let two_sided = is_open(&caster);
-            if !self.bounds.iter().any(|(id, _)| *id == o.mesh.id()) {
-                self.bounds.push((o.mesh.id(), nesting_bound(&caster, two_sided)));
-            }
+            let two_sided = facts.iter().any(|(id, f)| *id == o.mesh.id() && f.two_sided);
             let volumes =
                 points.iter().map(|q| shadow_volume(&caster, &light_facing(&caster, *q), two_sided)).collect();
             *cached = Some((key, volumes));
@@ -205,8 +238,7 @@ impl ShadowVolumes {
         let mut groups: Vec<Vec<usize>> = Vec::new();
         let mut room = 0;
         for (i, o) in frame.scene.objects.iter().enumerate().filter(|(_, o)| o.casts) {
-            let bound = self.bounds.iter().find(|(id, _)| *id == o.mesh.id()).map_or(COUNT_MASK, |b| b.1);
-            let bound = bound.min(COUNT_MASK);
+            let bound = self.facts_of(o.mesh.id()).bound.min(COUNT_MASK);
             if groups.is_empty() || bound > room {
                 groups.push(Vec::new());
                 room = COUNT_MASK;
@@ -246,7 +278,7 @@ impl ShadowVolumes {
                     }
                     *count = ((out.len() - start) / VERTEX_FLOATS) as u32;
                 }
-                ranges.push(GroupRange { first, sides: counts[0], caps: counts[1], turned: counts[2] });
+                ranges.push((first, counts));
             }
         }
         (out, ranges)
@@ -288,15 +320,34 @@ impl Technique for ShadowVolumes {
         let points: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
         let z_fail = Self::z_fail(frame, params, &points);
         let reach = Self::extrusion(frame, &points).unwrap_or(0.0);
-        self.build(frame, &points);
+        self.learn_meshes(frame);
         let groups = self.groups(frame);
-        let (vertices, ranges) = self.vertices(frame, points.len(), &groups);
-        if !vertices.is_empty() {
-            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-            let bytes: &[u8] = cast_slice(&vertices);
-            PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
-                .write(frame.slot, bytes);
-        }
+        let on_gpu = params.is_on(&GPU_SILHOUETTES);
+        // The CPU path's ranges; the GPU path's are its draw commands.
+        let ranges = if on_gpu {
+            let sided: Vec<Vec<(usize, bool)>> = groups
+                .iter()
+                .map(|g| g.iter().map(|&i| (i, self.facts_of(frame.scene.objects[i].mesh.id()).two_sided)).collect())
+                .collect();
+            let gpu = match &mut self.gpu {
+                Some(gpu) => gpu,
+                None => self.gpu.insert(GpuVolumes::new(ctx)?),
+            };
+            gpu.prepare(frame, &points, &sided)?;
+            Vec::new()
+        } else {
+            let start = Instant::now();
+            self.build(frame, &points);
+            let (vertices, ranges) = self.vertices(frame, points.len(), &groups);
+            if !vertices.is_empty() {
+                let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+                let bytes: &[u8] = cast_slice(&vertices);
+                PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
+                    .write(frame.slot, bytes);
+            }
+            frame.cpu_spans.push(("silhouettes", start.elapsed().as_secs_f64() * 1e3));
+            ranges
+        };
         let views: Vec<SampleView> = samples
             .iter()
             .map(|s| (s.position, s.normal.extend(s.weight)))
@@ -322,10 +373,25 @@ impl Technique for ShadowVolumes {
         // drawing them as well changes nothing.
         let caps = z_fail || reach > 0.0;
         span(frame, !timed, "accumulate");
-        for (p, point_ranges) in ranges.chunks(groups.len()).enumerate() {
+        for p in 0..points.len() {
+            if let Some(gpu) = self.gpu.as_ref().filter(|_| on_gpu) {
+                span(frame, timed, "silhouettes");
+                gpu.record(frame, p)?;
+                end_span(frame, timed);
+            }
             let view = Descriptor::Buffer(self.accumulation.view(frame.slot, p));
             let inputs = [Descriptor::Buffer(frame.globals), view, Descriptor::Buffer(frame.objects)];
-            for (g, range) in point_ranges.iter().enumerate() {
+            let (cpu_vertices, gpu) = (&self.vertices, &self.gpu);
+            let draw = |frame: &FrameInputs<'_>, g: usize, part: usize| match ranges.get(p * groups.len() + g) {
+                Some(&(first, counts)) => {
+                    if let Some(vb) = cpu_vertices {
+                        let before: u32 = counts[..part].iter().sum();
+                        draw_vertices(ctx, cmd, vb.range(frame.slot), first + before, counts[part]);
+                    }
+                }
+                None => gpu.as_ref().expect("the GPU path").draw(frame, p, g, part),
+            };
+            for g in 0..groups.len() {
                 let first = p == 0 && g == 0;
                 span(frame, timed, "volumes");
                 transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, first)]);
@@ -339,12 +405,9 @@ impl Technique for ShadowVolumes {
                     self.depth_copy.bind(ctx, cmd, &[Descriptor::Image(frame.depth)])?;
                     draw_fullscreen(ctx, cmd);
                 }
-                let vb = self.vertices.as_ref().map(|v| v.range(frame.slot));
                 let counting = if z_fail { &self.zfail } else { &self.zpass };
                 counting.bind(ctx, cmd, &inputs)?;
-                if let Some(vb) = vb {
-                    draw_vertices(ctx, cmd, vb, range.first, range.sides);
-                }
+                draw(frame, g, 0);
                 if several && !caps {
                     self.mark.bind(ctx, cmd, &[])?;
                     draw_fullscreen(ctx, cmd);
@@ -355,13 +418,11 @@ impl Technique for ShadowVolumes {
                     span(frame, timed, "caps");
                     transition(ctx, cmd, &mut [(ds, Access::DEPTH_STENCIL_WRITE, false)]);
                     let pass = RenderPass::begin(ctx, cmd, &[], Some(Attachment { target: ds, clear: None }));
-                    if let Some(vb) = vb {
-                        counting.bind(ctx, cmd, &inputs)?;
-                        draw_vertices(ctx, cmd, vb, range.first + range.sides, range.caps);
-                        if z_fail {
-                            self.zfail_turned.bind(ctx, cmd, &inputs)?;
-                            draw_vertices(ctx, cmd, vb, range.first + range.sides + range.caps, range.turned);
-                        }
+                    counting.bind(ctx, cmd, &inputs)?;
+                    draw(frame, g, 1);
+                    if z_fail {
+                        self.zfail_turned.bind(ctx, cmd, &inputs)?;
+                        draw(frame, g, 2);
                     }
                     if several {
                         self.mark.bind(ctx, cmd, &[])?;
@@ -386,6 +447,7 @@ impl Technique for ShadowVolumes {
         }
         this.accumulation.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
+        this.gpu.into_iter().for_each(|g| g.destroy(ctx));
         this.depth_stencil.into_iter().for_each(|t| t.destroy(ctx));
     }
 }

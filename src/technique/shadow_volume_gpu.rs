@@ -1,0 +1,228 @@
+//! The shadow volumes built on the GPU (`gpu_silhouettes = 1`), beyond the papers, which find
+//! silhouettes on the host: per light point, one compute dispatch per caster
+//! (`glsl/shadow_volume/silhouettes.comp`) extracts the silhouette edges, extrudes them and
+//! emits the caps into one vertex buffer, in the ranges of three indirect draws per caster
+//! group (sides, caps, turned caps), which the counting passes draw. The vertices are the CPU
+//! path's, so the counts, and V, are the same. Each mesh's positions, triangles and edges are
+//! uploaded once; the vertex buffer holds one point's volumes and is rebuilt for the next.
+
+use ash::vk;
+use bytemuck::{Pod, cast_slice};
+use glam::{Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+
+use crate::error::Result;
+use crate::frame::FrameInputs;
+use crate::frame::interface::VolumeParams;
+use crate::geometry::NO_FACE;
+use crate::gpu::{
+    Buffer, BufferAccess, Context, Descriptor, PerFrame, Pipeline, buffer_barrier, dispatch, draw_indirect, shaders,
+    upload,
+};
+use crate::scene::{Mesh, MeshId};
+
+const GROUP: u32 = 64;
+const PARAMS_BYTES: u64 = std::mem::size_of::<VolumeParams>() as u64;
+/// An indirect draw command: vertex count, instance count, first vertex, first instance.
+const COMMAND_BYTES: u64 = 16;
+/// Bytes per volume vertex: position, at infinity, object (as the CPU path's).
+const VERTEX_BYTES: u64 = 20;
+/// Draws per caster group and point: sides, caps, turned caps.
+pub const PARTS: usize = 3;
+
+/// One mesh on the GPU: positions, triangles and edges in one buffer, and the most vertices
+/// each part of its volume can take.
+struct MeshData {
+    buffer: Buffer,
+    triangles_at: u32,
+    edges_at: u32,
+    triangles: u32,
+    edges: u32,
+    most: [u32; PARTS],
+}
+
+impl MeshData {
+    fn new(ctx: &Context, mesh: &Mesh) -> Result<Self> {
+        let edges = &mesh.adjacency.edges;
+        let mut data: Vec<[u32; 4]> = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 0.0].map(f32::to_bits)).collect();
+        let triangles_at = data.len() as u32;
+        data.extend(mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]));
+        let edges_at = data.len() as u32;
+        data.extend(edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]));
+        let buffer = upload(ctx, "volume mesh", cast_slice(&data), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        // An edge is extruded once per face on it, at most; a triangle gives a dark and a light
+        // cap, or a dark and a turned one.
+        let faces: u32 = edges.iter().map(|e| e.faces.iter().filter(|&&f| f != NO_FACE).count() as u32).sum();
+        let triangles = mesh.triangles.len() as u32;
+        Ok(MeshData {
+            buffer,
+            triangles_at,
+            edges_at,
+            triangles,
+            edges: edges.len() as u32,
+            most: [6 * faces, 6 * triangles, 3 * triangles],
+        })
+    }
+}
+
+/// One caster's dispatch: its mesh, where its params sit among a point's, and its group.
+struct Dispatch {
+    mesh: usize,
+    object: usize,
+    group: usize,
+    two_sided: bool,
+}
+
+pub struct GpuVolumes {
+    pipeline: Pipeline,
+    meshes: Vec<(MeshId, MeshData)>,
+    params: Option<PerFrame>,
+    commands: Option<PerFrame>,
+    vertices: Option<Buffer>,
+    dispatches: Vec<Dispatch>,
+    groups: usize,
+}
+
+impl GpuVolumes {
+    pub fn new(ctx: &Context) -> Result<Self> {
+        let pipeline = Pipeline::compute(ctx, "silhouettes", &shaders::SHADOW_VOLUME_SILHOUETTES_COMP, &[])?;
+        Ok(GpuVolumes {
+            pipeline,
+            meshes: Vec::new(),
+            params: None,
+            commands: None,
+            vertices: None,
+            dispatches: Vec::new(),
+            groups: 0,
+        })
+    }
+
+    /// Lays out this frame's volumes: for every point and caster of `groups` (scene object
+    /// indices, each with whether it takes the two-sided construction) its params, for every
+    /// point and group its three draw commands, each range sized for the most it can take.
+    pub fn prepare(&mut self, frame: &FrameInputs<'_>, points: &[Vec3], groups: &[Vec<(usize, bool)>]) -> Result<()> {
+        let ctx = frame.ctx;
+        self.dispatches.clear();
+        self.groups = groups.len();
+        for (g, group) in groups.iter().enumerate() {
+            for &(object, two_sided) in group {
+                let mesh = &frame.scene.objects[object].mesh;
+                let at = match self.meshes.iter().position(|(id, _)| *id == mesh.id()) {
+                    Some(at) => at,
+                    None => {
+                        self.meshes.push((mesh.id(), MeshData::new(ctx, mesh)?));
+                        self.meshes.len() - 1
+                    }
+                };
+                self.dispatches.push(Dispatch { mesh: at, object, group: g, two_sided });
+            }
+        }
+        // One point's ranges, group by group: [first, end) of each part.
+        let mut ranges = vec![[(0u32, 0u32); PARTS]; groups.len()];
+        let mut end = 0u32;
+        for (g, range) in ranges.iter_mut().enumerate() {
+            for (k, part) in range.iter_mut().enumerate() {
+                let most: u32 = self
+                    .dispatches
+                    .iter()
+                    .filter(|d| d.group == g && (k < 2 || d.two_sided))
+                    .map(|d| self.meshes[d.mesh].1.most[k])
+                    .sum();
+                *part = (end, end + most);
+                end += most;
+            }
+        }
+        let commands: Vec<[u32; 4]> =
+            points.iter().flat_map(|_| ranges.iter().flatten().map(|&(first, _)| [0, 1, first, 0])).collect();
+        let mut params = Vec::with_capacity(points.len() * self.dispatches.len());
+        for (p, q) in points.iter().enumerate() {
+            for d in &self.dispatches {
+                let (mesh, object) = (&self.meshes[d.mesh].1, &frame.scene.objects[d.object]);
+                let command = |k: usize| ((p * groups.len() + d.group) * PARTS + k) as u32;
+                let [sides, caps, turned] = ranges[d.group];
+                params.push(VolumeParams {
+                    model: object.transform.matrix(),
+                    light: q.extend(1.0),
+                    counts: [mesh.edges, mesh.triangles, d.two_sided as u32, frame.draws[d.object].instance],
+                    offsets: [mesh.triangles_at, mesh.edges_at, 0, 0],
+                    commands: [command(0), command(1), command(2), 0],
+                    ends: [sides.1, caps.1, turned.1, 0],
+                    pad: [Vec4::ZERO; 7],
+                });
+            }
+        }
+        write(ctx, &mut self.params, frame.slot, "volume params", vk::BufferUsageFlags::UNIFORM_BUFFER, &params)?;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER;
+        write(ctx, &mut self.commands, frame.slot, "volume draws", usage, &commands)?;
+        let bytes = (end.max(1) as u64 * VERTEX_BYTES).next_power_of_two();
+        if self.vertices.as_ref().is_none_or(|v| v.range().range < bytes) {
+            ctx.wait_idle()?;
+            self.vertices.take().into_iter().for_each(|v| v.destroy(ctx));
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER;
+            self.vertices = Some(Buffer::new(ctx, "gpu shadow volumes", bytes, usage, MemoryLocation::GpuOnly)?);
+        }
+        Ok(())
+    }
+
+    /// Records the dispatches that build point `p`'s volumes (after [`Self::prepare`]).
+    pub fn record(&self, frame: &FrameInputs<'_>, p: usize) -> Result<()> {
+        let (ctx, cmd) = (frame.ctx, frame.cmd);
+        let params = self.params.as_ref().expect("prepared").range(frame.slot);
+        let commands = self.commands.as_ref().expect("prepared").range(frame.slot);
+        let vertices = self.vertices.as_ref().expect("prepared").range();
+        // The previous point's draws, or an earlier frame's, read the same vertices.
+        buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::COMPUTE_READ_WRITE);
+        for (i, d) in self.dispatches.iter().enumerate() {
+            let mesh = &self.meshes[d.mesh].1;
+            let one = vk::DescriptorBufferInfo {
+                buffer: params.buffer,
+                offset: params.offset + (p * self.dispatches.len() + i) as u64 * PARAMS_BYTES,
+                range: PARAMS_BYTES,
+            };
+            let inputs = [
+                Descriptor::Buffer(one),
+                Descriptor::Buffer(mesh.buffer.range()),
+                Descriptor::Buffer(commands),
+                Descriptor::Buffer(vertices),
+            ];
+            self.pipeline.bind(ctx, cmd, &inputs)?;
+            dispatch(ctx, cmd, mesh.edges.max(mesh.triangles).div_ceil(GROUP));
+        }
+        buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
+        Ok(())
+    }
+
+    /// Draws part `part` (0 sides, 1 caps, 2 turned caps) of group `g` of point `p`'s volumes
+    /// with the bound pipeline.
+    pub fn draw(&self, frame: &FrameInputs<'_>, p: usize, g: usize, part: usize) {
+        let commands = self.commands.as_ref().expect("prepared").range(frame.slot);
+        let command = vk::DescriptorBufferInfo {
+            buffer: commands.buffer,
+            offset: commands.offset + ((p * self.groups + g) * PARTS + part) as u64 * COMMAND_BYTES,
+            range: COMMAND_BYTES,
+        };
+        let vertices = self.vertices.as_ref().expect("prepared").range();
+        draw_indirect(frame.ctx, frame.cmd, vertices, command);
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.pipeline.destroy(ctx);
+        self.meshes.into_iter().for_each(|(_, m)| m.buffer.destroy(ctx));
+        self.params.into_iter().chain(self.commands).for_each(|b| b.destroy(ctx));
+        self.vertices.into_iter().for_each(|v| v.destroy(ctx));
+    }
+}
+
+/// Writes `items` into this frame's copy of `slot`, grown to hold them.
+fn write<T: Pod>(
+    ctx: &Context,
+    slot: &mut Option<PerFrame>,
+    frame: usize,
+    name: &str,
+    usage: vk::BufferUsageFlags,
+    items: &[T],
+) -> Result<()> {
+    let bytes: &[u8] = cast_slice(items);
+    PerFrame::ensure(ctx, slot, name, bytes.len().max(16) as u64, usage)?.write(frame, bytes);
+    Ok(())
+}
