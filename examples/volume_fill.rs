@@ -56,39 +56,60 @@ fn fill(scene: &Scene, aspect: f32) -> (f64, f64) {
     (sides, all)
 }
 
-/// Median GPU ms of the frame, and of its `volumes` and `caps` passes.
+/// What is measured at each K: the technique, its knobs, and whether its fill passes are shown.
+const RUNS: [(&str, &[(&str, &str)]); 7] = [
+    ("shadow-map", &[]),
+    ("shadow-volume", &[("counting", "1")]),
+    ("shadow-volume", &[("counting", "2")]),
+    ("shadow-volume", &[("counting", "2"), ("gpu_silhouettes", "1")]),
+    ("shadow-volume", &[("samples", "4")]),
+    ("shadow-volume", &[("samples", "16")]),
+    ("shadow-volume", &[("samples", "64")]),
+];
+
+/// Per run of [`RUNS`], median GPU ms of the frame and of its `volumes` and `caps` passes. One
+/// engine per run, their frames taken in turn, so that the machine's load falls on all alike.
 fn measure(
-    engine: &mut Engine,
+    engines: &mut [Engine],
     scene: &Scene,
-    settings: &FrameSettings,
-    technique: &str,
-    sets: &[(&str, &str)],
+    size: u32,
     frames: usize,
-) -> Result<(f64, f64), Box<dyn std::error::Error>> {
-    let mut settings = settings.clone();
-    settings.params = Params::defaults(find(technique)?);
-    settings.params.apply(sets.iter().copied())?;
-    for _ in 0..WARMUP {
-        engine.render(scene, &settings)?;
+) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
+    let mut settings = Vec::new();
+    for (technique, sets) in RUNS {
+        let mut s = FrameSettings::from_scene(scene)?;
+        (s.width, s.height) = (size, size);
+        s.params = Params::defaults(find(technique)?);
+        s.params.apply(sets.iter().copied())?;
+        settings.push(s);
     }
-    engine.flush()?;
-    engine.take_timings();
-    for _ in 0..frames {
-        engine.render(scene, &settings)?;
+    for i in 0..WARMUP + frames {
+        for (engine, s) in engines.iter_mut().zip(&settings) {
+            engine.render(scene, s)?;
+            engine.flush()?;
+            if i < WARMUP {
+                engine.take_timings();
+            }
+        }
     }
-    engine.flush()?;
-    let timings = engine.take_timings();
-    let report = TimingReport::new(engine.device(), technique, settings.width, settings.height, &timings);
-    let pass = |name: &str| report.passes.iter().find(|p| p.name == name).map_or(0.0, |p| p.gpu_ms_median);
-    Ok((report.gpu_ms_total_median, pass("volumes") + pass("caps")))
+    let mut out = Vec::new();
+    for (engine, s) in engines.iter_mut().zip(&settings) {
+        let timings = engine.take_timings();
+        let report = TimingReport::new(engine.device(), s.params.technique.name, size, size, &timings);
+        let pass = |name: &str| report.passes.iter().find(|p| p.name == name).map_or(0.0, |p| p.gpu_ms_median);
+        out.push((report.gpu_ms_total_median, pass("volumes") + pass("caps")));
+    }
+    Ok(out)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let size: u32 = args.next().map_or(Ok(512), |a| a.parse())?;
     let frames: usize = args.next().map_or(Ok(8), |a| a.parse())?;
-    let mut engine = Engine::headless(&ContextOptions::from_env())?;
-    println!("{} ({}), {size}², median of {frames} frames\n", engine.device().name, engine.device().driver);
+    let options = ContextOptions::from_env();
+    let mut engines = RUNS.iter().map(|_| Engine::headless(&options)).collect::<Result<Vec<_>, _>>()?;
+    let device = engines[0].device();
+    println!("{} ({}), {size}², median of {frames} frames\n", device.name, device.driver);
     println!(
         "| K | fill z-pass | fill z-fail | shadow-map ms | z-pass ms (fill ms) | ratio | z-fail ms (fill ms) | ratio \
          | GPU silhouettes z-fail ms | ratio | N=4 ms | ratio | N=16 ms | ratio | N=64 ms | ratio |"
@@ -96,29 +117,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for k in [1, 2, 4, 8, 16, 32] {
         let scene = posts(k)?;
-        let mut settings = FrameSettings::from_scene(&scene)?;
-        (settings.width, settings.height) = (size, size);
         let (fill_pass, fill_fail) = fill(&scene, 1.0);
-        let (map, _) = measure(&mut engine, &scene, &settings, "shadow-map", &[], frames)?;
+        let ms = measure(&mut engines, &scene, size, frames)?;
+        let map = ms[0].0;
         let mut row = format!("| {k} | {fill_pass:.2} | {fill_fail:.2} | {map:.2} |");
-        let runs: [&[(&str, &str)]; 6] = [
-            &[("counting", "1")],
-            &[("counting", "2")],
-            &[("counting", "2"), ("gpu_silhouettes", "1")],
-            &[("samples", "4")],
-            &[("samples", "16")],
-            &[("samples", "64")],
-        ];
-        for (i, sets) in runs.iter().enumerate() {
-            let (total, filling) = measure(&mut engine, &scene, &settings, "shadow-volume", sets, frames)?;
-            let filled = if i < 2 { format!(" ({filling:.2})") } else { String::new() };
+        for (i, (total, filling)) in ms.iter().enumerate().skip(1) {
+            let filled = if i < 3 { format!(" ({filling:.2})") } else { String::new() };
             row += &format!(" {total:.2}{filled} | {:.2} |", total / map);
         }
         println!("{row}");
     }
-    let errors = engine.finish();
-    if !errors.is_empty() {
-        return Err(errors.join("\n").into());
+    for engine in engines {
+        let errors = engine.finish();
+        if !errors.is_empty() {
+            return Err(errors.join("\n").into());
+        }
     }
     Ok(())
 }
