@@ -129,7 +129,7 @@ pub fn screen_fill(volume: &ShadowVolume, positions: &[Vec3], light: Vec3, view_
         triangles.extend(volume.far_caps.iter().map(|t| t.map(clip)));
         triangles.extend(volume.near_caps.iter().chain(&volume.turned_caps).map(near));
     }
-    triangles.iter().map(|t| screen_area(t)).sum()
+    triangles.iter().map(screen_area).sum()
 }
 
 /// The area of the clip-space triangle `t` on the screen, in screens.

@@ -65,7 +65,8 @@ impl MeshData {
     }
 }
 
-/// One caster's dispatch: its mesh, where its params sit among a point's, and its group.
+/// One caster's dispatch: its mesh (in `meshes`), its scene object, its group, and whether it
+/// takes the two-sided construction.
 struct Dispatch {
     mesh: usize,
     object: usize,
