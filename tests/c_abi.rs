@@ -62,6 +62,9 @@ fn compile(name: &str, libs: &[&str]) -> PathBuf {
         .arg(format!("-I{}", root().join("include").display()))
         .arg(format!("-L{}", lib.display()))
         .arg(format!("-Wl,-rpath,{}", lib.display()))
+        // DT_RPATH, not RUNPATH: searched before LD_LIBRARY_PATH, where cargo puts target/debug
+        // and with it any older libsoftshadow.so a `cargo build` left there.
+        .arg("-Wl,--disable-new-dtags")
         .args(["-lsoftshadow", "-lm"])
         .args(libs)
         .arg("-o")
@@ -129,8 +132,8 @@ fn the_c_game_loop_runs_and_shadows_where_physics_says() {
 /// validation, its own depth: the ground seen straight down, the box's top over it), recorded by
 /// `softshadow_record` into its command buffers and submitted by it. With the light at (4, 8, 0),
 /// the box's top edge at x = 0.5 falls on the ground at x = 0: V there is dark, the open ground
-/// and the box's top are lit, every pass took time (the import first), and the layer reported no
-/// error.
+/// and the box's top are lit, every pass took time (the import first), the layer reported no
+/// error, and the embedder's host allocator served the engine and got every block back.
 #[test]
 fn a_c_renderer_records_the_shadow_into_its_own_command_buffers() {
     let exe = compile("embedder", &["-lvulkan"]);
@@ -141,6 +144,9 @@ fn a_c_renderer_records_the_shadow_into_its_own_command_buffers() {
     eprintln!("{stdout}{}", String::from_utf8_lossy(&output.stderr));
     assert!(output.status.success(), "embedder failed");
     assert!(stdout.contains("; 0 validation errors"), "{stdout}");
+    let host = stdout.lines().find_map(|l| l.strip_prefix("host blocks through the callbacks: ")).expect("host blocks");
+    let made: usize = host.split(' ').next().unwrap().parse().unwrap();
+    assert!(made > 0 && host.ends_with(" 0 alive after the engine"), "the embedder's host allocator: {host}");
     let passes: Vec<(&str, f64)> = stdout
         .lines()
         .filter_map(|l| l.strip_prefix("pass "))

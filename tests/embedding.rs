@@ -9,8 +9,8 @@ mod common;
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
-use softshadow::geometry::{Aabb, CameraProjection};
 use softshadow::frame::interface::{FrameGlobals, ObjectData};
+use softshadow::geometry::{Aabb, CameraProjection};
 use softshadow::gpu::Access;
 use softshadow::scene::Scene;
 use softshadow::technique::{Params, find};
@@ -213,7 +213,8 @@ impl DepthPrepass {
             let layouts = [set_layout];
             let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
             let set = d.allocate_descriptor_sets(&alloc).unwrap()[0];
-            let infos = [0, 1].map(|i| [vk::DescriptorBufferInfo::default().buffer(buffers[i].buffer).range(vk::WHOLE_SIZE)]);
+            let infos =
+                [0, 1].map(|i| [vk::DescriptorBufferInfo::default().buffer(buffers[i].buffer).range(vk::WHOLE_SIZE)]);
             let writes = [0, 1].map(|i| {
                 vk::WriteDescriptorSet::default()
                     .dst_set(set)
@@ -231,7 +232,8 @@ impl DepthPrepass {
                 .module(module)
                 .name(c"main")];
             let stride = std::mem::size_of::<softshadow::scene::Vertex>() as u32;
-            let vertex_bindings = [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
+            let vertex_bindings =
+                [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
             let attributes = [0, 12].map(|offset| vk::VertexInputAttributeDescription {
                 location: offset / 12,
                 binding: 0,
@@ -243,14 +245,14 @@ impl DepthPrepass {
                 .vertex_attribute_descriptions(&attributes);
             let assembly =
                 vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-            let viewports = [vk::Viewport { width: SIDE as f32, height: SIDE as f32, max_depth: 1.0, ..Default::default() }];
+            let viewports =
+                [vk::Viewport { width: SIDE as f32, height: SIDE as f32, max_depth: 1.0, ..Default::default() }];
             let scissors = [vk::Rect2D { extent: EXTENT, ..Default::default() }];
             let viewport = vk::PipelineViewportStateCreateInfo::default().viewports(&viewports).scissors(&scissors);
-            let raster = vk::PipelineRasterizationStateCreateInfo::default()
-                .cull_mode(vk::CullModeFlags::NONE)
-                .line_width(1.0);
-            let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-                .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+            let raster =
+                vk::PipelineRasterizationStateCreateInfo::default().cull_mode(vk::CullModeFlags::NONE).line_width(1.0);
+            let multisample =
+                vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
             // Reverse Z: nearer is greater.
             let depth = vk::PipelineDepthStencilStateCreateInfo::default()
                 .depth_test_enable(true)
@@ -730,5 +732,93 @@ fn an_engine_that_only_records_makes_no_shading_targets() {
     assert_eq!(engine.context().live_allocations(), recording + 3, "allocations of the engine's own frame");
     frames.destroy(&e);
     drop(engine);
+    e.finish();
+}
+
+/// Host memory handed out through an embedder's allocation callbacks: how many blocks, and the
+/// layout of each block alive.
+#[derive(Default)]
+struct HostAllocations {
+    made: std::sync::atomic::AtomicUsize,
+    live: std::sync::Mutex<std::collections::HashMap<usize, std::alloc::Layout>>,
+}
+
+unsafe extern "system" fn allocate(
+    user: *mut std::ffi::c_void,
+    size: usize,
+    align: usize,
+    _: vk::SystemAllocationScope,
+) -> *mut std::ffi::c_void {
+    // SAFETY: `user` is the test's HostAllocations, alive until the engine is dropped.
+    let a = unsafe { &*(user as *const HostAllocations) };
+    let layout = std::alloc::Layout::from_size_align(size.max(1), align.max(1)).unwrap();
+    // SAFETY: a non-zero size.
+    let p = unsafe { std::alloc::alloc(layout) };
+    a.made.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    a.live.lock().unwrap().insert(p as usize, layout);
+    p.cast()
+}
+
+unsafe extern "system" fn free(user: *mut std::ffi::c_void, p: *mut std::ffi::c_void) {
+    if p.is_null() {
+        return;
+    }
+    // SAFETY: as `allocate`; `p` came from it (a foreign pointer fails the lookup).
+    let a = unsafe { &*(user as *const HostAllocations) };
+    let layout = a.live.lock().unwrap().remove(&(p as usize)).expect("a block these callbacks made");
+    unsafe { std::alloc::dealloc(p.cast(), layout) };
+}
+
+unsafe extern "system" fn reallocate(
+    user: *mut std::ffi::c_void,
+    original: *mut std::ffi::c_void,
+    size: usize,
+    align: usize,
+    scope: vk::SystemAllocationScope,
+) -> *mut std::ffi::c_void {
+    if size == 0 {
+        unsafe { free(user, original) };
+        return std::ptr::null_mut();
+    }
+    let moved = unsafe { allocate(user, size, align, scope) };
+    if !original.is_null() {
+        let a = unsafe { &*(user as *const HostAllocations) };
+        let old = a.live.lock().unwrap()[&(original as usize)].size();
+        unsafe { std::ptr::copy_nonoverlapping(original as *const u8, moved as *mut u8, old.min(size)) };
+        unsafe { free(user, original) };
+    }
+    moved
+}
+
+/// The embedder's host allocator is used for the engine's objects, and everything allocated
+/// through it is freed once the engine is dropped; the validation layer (the embedder's
+/// messenger) would report any object destroyed with other callbacks than it was made with.
+#[test]
+fn the_embedders_allocation_callbacks_serve_and_are_all_freed() {
+    let e = embedder();
+    let host = Box::new(HostAllocations::default());
+    let callbacks = vk::AllocationCallbacks::default()
+        .user_data(&*host as *const HostAllocations as *mut std::ffi::c_void)
+        .pfn_allocation(Some(allocate))
+        .pfn_reallocation(Some(reallocate))
+        .pfn_free(Some(free));
+    let handles = softshadow::gpu::EmbedderHandles {
+        allocation_callbacks: Some(callbacks),
+        ..e.handles(softshadow::required_device_features())
+    };
+    let mut engine = unsafe { Engine::from_handles(handles) }.unwrap();
+    let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, false);
+    frames.own_target = true;
+    let (s, p) = (scene(0.0), params("pcss"));
+    for _ in 0..3 {
+        frames.run_into_own_target(&e, &mut engine, &Shot { scene: &s, params: &p, camera: camera(true), box_x: 0.0 });
+    }
+    engine.flush().unwrap();
+    let made = host.made.load(std::sync::atomic::Ordering::Relaxed);
+    assert!(made > 0, "no host allocation went through the embedder's callbacks");
+    drop(engine);
+    let live = host.live.lock().unwrap().len();
+    assert_eq!(live, 0, "{live} of {made} blocks allocated through the callbacks outlive the engine");
+    frames.destroy(&e);
     e.finish();
 }

@@ -3,8 +3,9 @@
  * y = 0 and the top of a box, seen straight down through an orthographic camera, cleared into a
  * D32 reverse-Z depth image), and softshadow_record writing the box's shadow V into the
  * engine's target inside the embedder's command buffers, which it submits itself, two frames in
- * flight. The last frame's V is copied out and written as a 16-bit PGM; the last finished
- * frame's pass times are printed.
+ * flight. The engine gets the embedder's host allocator (VkAllocationCallbacks counting its
+ * blocks). The last frame's V is copied out and written as a 16-bit PGM; the last finished
+ * frame's pass times and the host blocks made and still alive after the engine are printed.
  *
  *   cc examples/c/embedder.c -Iinclude -Ltarget/debug -lsoftshadow -lvulkan -o embedder
  *   ./embedder OUT_DIR
@@ -59,6 +60,47 @@ static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlag
         fprintf(stderr, "validation: %s\n", data->pMessage);
     }
     return VK_FALSE;
+}
+
+/* The embedder's host allocator: C11 aligned_alloc, each block prefixed by its size and
+ * alignment, counted. */
+static size_t host_made = 0, host_live = 0;
+
+static void *VKAPI_CALL host_allocate(void *user, size_t size, size_t align, VkSystemAllocationScope scope) {
+    (void)user;
+    (void)scope;
+    if (align < 2 * sizeof(size_t)) align = 2 * sizeof(size_t);
+    size_t total = (size + 2 * align - 1) / align * align; /* the prefix takes one alignment */
+    unsigned char *base = aligned_alloc(align, total);
+    if (!base) return NULL;
+    unsigned char *p = base + align;
+    ((size_t *)p)[-1] = size;
+    ((size_t *)p)[-2] = align;
+    host_made++;
+    host_live++;
+    return p;
+}
+
+static void VKAPI_CALL host_free(void *user, void *memory) {
+    (void)user;
+    if (!memory) return;
+    size_t align = ((size_t *)memory)[-2];
+    free((unsigned char *)memory - align);
+    host_live--;
+}
+
+static void *VKAPI_CALL host_reallocate(void *user, void *original, size_t size, size_t align, VkSystemAllocationScope scope) {
+    if (size == 0) {
+        host_free(user, original);
+        return NULL;
+    }
+    void *moved = host_allocate(user, size, align, scope);
+    if (moved && original) {
+        size_t old = ((size_t *)original)[-1];
+        memcpy(moved, original, old < size ? old : size);
+        host_free(user, original);
+    }
+    return moved;
 }
 
 static const float CUBE[8 * 3] = {
@@ -201,6 +243,11 @@ int main(int argc, char **argv) {
 
     /* The engine on the embedder's objects, and the scene: a box at x = 1 under a light at
      * (4, 8, 0). The scene's own camera is not used on this path. */
+    const VkAllocationCallbacks host = {
+        .pfnAllocation = host_allocate,
+        .pfnReallocation = host_reallocate,
+        .pfnFree = host_free,
+    };
     softshadow_vulkan vulkan = {
         .get_instance_proc_addr = (const void *)vkGetInstanceProcAddr,
         .instance = instance,
@@ -208,6 +255,7 @@ int main(int argc, char **argv) {
         .device = device,
         .queue_family = family,
         .queue_index = 0,
+        .allocation_callbacks = &host,
     };
     softshadow_engine *engine = NULL;
     CHECK(softshadow_engine_create_from_vulkan(&vulkan, &engine));
@@ -418,6 +466,7 @@ int main(int argc, char **argv) {
     /* The engine first: it destroys only what it made. */
     CHECK(softshadow_engine_destroy(engine));
     CHECK(softshadow_scene_destroy(scene));
+    printf("host blocks through the callbacks: %zu made, %zu alive after the engine\n", host_made, host_live);
     for (int i = 0; i < 2; i++) vkDestroyFence(device, fences[i], NULL);
     vkDestroyCommandPool(device, pool, NULL);
     vkDestroyBuffer(device, readback, NULL);
@@ -429,5 +478,5 @@ int main(int argc, char **argv) {
     destroy_messenger(instance, messenger, NULL);
     vkDestroyInstance(instance, NULL);
     printf("%d frames recorded; wrote %s; %d validation errors\n", FRAMES, path, validation_errors);
-    return validation_errors == 0 ? 0 : 1;
+    return validation_errors == 0 && host_live == 0 ? 0 : 1;
 }

@@ -200,7 +200,8 @@ mod tests {
     #[test]
     fn right_is_plus_x_and_up_is_minus_y_in_ndc() {
         for projection in [Projection::Perspective { fov_y_deg: 45.0 }, Projection::Orthographic { half_height: 2.0 }] {
-            let cam = CameraProjection::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene()).unwrap();
+            let cam = CameraProjection::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene())
+                .unwrap();
             // Looking down −Z with +Y up, world +X is to the right and +Y is the top row.
             assert!(ndc(&cam.view_proj, Vec3::X * 0.5).x > 0.0);
             assert!(ndc(&cam.view_proj, Vec3::Y * 0.5).y < 0.0);
@@ -214,7 +215,8 @@ mod tests {
     fn an_embedders_matrices_give_the_same_camera() {
         let (eye, target) = (Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO);
         let ours =
-            CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene()).unwrap();
+            CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene())
+                .unwrap();
         // A right-handed look-at (view down −z) and [0, 1]-depth perspectives, y flipped for
         // Vulkan: depth 0 at `z0`, 1 at `z1`.
         let (f, s) = ((target - eye).normalize(), (target - eye).normalize().cross(Vec3::Y).normalize());
@@ -275,11 +277,14 @@ mod tests {
     #[test]
     fn the_engines_matrices_handed_back_give_the_same_camera() {
         for projection in [Projection::Perspective { fov_y_deg: 45.0 }, Projection::Orthographic { half_height: 2.0 }] {
-            let ours =
-                CameraProjection::new(Vec3::new(0.0, 5.0, 6.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene()).unwrap();
+            let ours = CameraProjection::new(Vec3::new(0.0, 5.0, 6.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene())
+                .unwrap();
             let back = CameraProjection::from_matrices(ours.view, ours.projection, true, ours.near, ours.far).unwrap();
             assert_eq!((back.view_proj, back.inv_view_proj), (ours.view_proj, ours.inv_view_proj));
-            assert_eq!((back.position, back.forward, back.frustum.corners), (ours.position, ours.forward, ours.frustum.corners));
+            assert_eq!(
+                (back.position, back.forward, back.frustum.corners),
+                (ours.position, ours.forward, ours.frustum.corners)
+            );
         }
     }
 }

@@ -439,7 +439,11 @@ impl Engine {
                 ctx,
                 frame.cmd,
                 &mut [
-                    (into.as_deref_mut().unwrap_or(&mut targets.shaded.as_mut().expect("ensured").color), Access::COPY_READ, false),
+                    (
+                        into.as_deref_mut().unwrap_or(&mut targets.shaded.as_mut().expect("ensured").color),
+                        Access::COPY_READ,
+                        false,
+                    ),
                     (&mut targets.depth, Access::COPY_READ, false),
                     (&mut targets.normal, Access::COPY_READ, false),
                     (&mut targets.visibility, Access::COPY_READ, false),
