@@ -226,7 +226,7 @@ fn softshadow_view_presents_and_writes_a_screenshot(_: &mut AppWindow) {
 fn wm_state(app: &AppWindow) -> Option<String> {
     use winit::raw_window_handle::{HasWindowHandle, RawWindowHandle};
     let id = match app.window().window_handle().expect("a window handle").as_raw() {
-        RawWindowHandle::Xlib(h) => h.window as u64,
+        RawWindowHandle::Xlib(h) => h.window,
         RawWindowHandle::Xcb(h) => h.window.get() as u64,
         other => panic!("not an X11 window: {other:?}"),
     };
