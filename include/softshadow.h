@@ -36,7 +36,10 @@ typedef struct softshadow_scene softshadow_scene;
 
 // The embedder's Vulkan objects: `vkGetInstanceProcAddr`, the instance, physical device and
 // device (created with `softshadow_required_device_extension` and the Vulkan 1.3 features
-// dynamicRendering, synchronization2 and maintenance4), and a queue of `queue_family`.
+// dynamicRendering, synchronization2 and maintenance4), a queue of `queue_family`, and
+// optionally the embedder's `VkAllocationCallbacks` (NULL: none), copied at creation and passed
+// to every `vkCreate*` / `vkDestroy*` of the engine's objects: its functions and user data must
+// outlive the engine. Device memory blocks are allocated without them.
 typedef struct softshadow_vulkan {
   const void *get_instance_proc_addr;
   const void *instance;
@@ -44,6 +47,7 @@ typedef struct softshadow_vulkan {
   const void *device;
   uint32_t queue_family;
   uint32_t queue_index;
+  const void *allocation_callbacks;
 } softshadow_vulkan;
 
 // The state an image is in: `VkImageLayout`, and the `VkPipelineStageFlags2` and

@@ -139,7 +139,10 @@ pub struct softshadow_pass_time {
 
 /// The embedder's Vulkan objects: `vkGetInstanceProcAddr`, the instance, physical device and
 /// device (created with `softshadow_required_device_extension` and the Vulkan 1.3 features
-/// dynamicRendering, synchronization2 and maintenance4), and a queue of `queue_family`.
+/// dynamicRendering, synchronization2 and maintenance4), a queue of `queue_family`, and
+/// optionally the embedder's `VkAllocationCallbacks` (NULL: none), copied at creation and passed
+/// to every `vkCreate*` / `vkDestroy*` of the engine's objects: its functions and user data must
+/// outlive the engine. Device memory blocks are allocated without them.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct softshadow_vulkan {
@@ -149,6 +152,31 @@ pub struct softshadow_vulkan {
     pub device: *const c_void,
     pub queue_family: u32,
     pub queue_index: u32,
+    pub allocation_callbacks: *const c_void,
+}
+
+/// The embedder's allocation callbacks at `p` (NULL: none), checked as Vulkan requires them:
+/// allocation, reallocation and free set, the internal notifications both set or neither.
+fn allocation_callbacks(p: *const c_void) -> Result<Option<vk::AllocationCallbacks<'static>>, Failure> {
+    // SAFETY: the caller's contract: NULL or a valid VkAllocationCallbacks.
+    let Some(c) = (unsafe { (p as *const vk::AllocationCallbacks<'_>).as_ref() }) else {
+        return Ok(None);
+    };
+    if c.pfn_allocation.is_none() || c.pfn_reallocation.is_none() || c.pfn_free.is_none() {
+        return Err(invalid("allocation_callbacks: pfnAllocation, pfnReallocation and pfnFree must all be set"));
+    }
+    if c.pfn_internal_allocation.is_some() != c.pfn_internal_free.is_some() {
+        return Err(invalid("allocation_callbacks: set both internal notifications or neither"));
+    }
+    Ok(Some(vk::AllocationCallbacks {
+        p_user_data: c.p_user_data,
+        pfn_allocation: c.pfn_allocation,
+        pfn_reallocation: c.pfn_reallocation,
+        pfn_free: c.pfn_free,
+        pfn_internal_allocation: c.pfn_internal_allocation,
+        pfn_internal_free: c.pfn_internal_free,
+        _marker: std::marker::PhantomData,
+    }))
 }
 
 /// The state an image is in: `VkImageLayout`, and the `VkPipelineStageFlags2` and
@@ -362,6 +390,8 @@ pub unsafe extern "C" fn softshadow_engine_create_from_vulkan(
         ] {
             non_null(p, what)?;
         }
+        // Checked before any handle is used.
+        let allocation_callbacks = allocation_callbacks(v.allocation_callbacks)?;
         // SAFETY: a non-NULL vkGetInstanceProcAddr, by the caller's contract.
         let get_proc: vk::PFN_vkGetInstanceProcAddr = unsafe { std::mem::transmute(v.get_instance_proc_addr) };
         let entry = unsafe { ash::Entry::from_static_fn(ash::StaticFn { get_instance_proc_addr: get_proc }) };
@@ -377,6 +407,7 @@ pub unsafe extern "C" fn softshadow_engine_create_from_vulkan(
             queue_index: v.queue_index,
             enabled_features: crate::gpu::required_vulkan13_features(),
             enabled_core_features: crate::gpu::required_core_features(),
+            allocation_callbacks,
         };
         // SAFETY: the caller's contract, passed on.
         let engine = unsafe { Engine::from_handles(handles) }?;

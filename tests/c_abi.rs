@@ -51,8 +51,9 @@ fn the_checked_in_header_is_generated_from_the_code() {
     }
 }
 
-/// Compiles `examples/c/NAME.c` with the system `cc` against the header and the shared library.
-fn compile(name: &str) -> PathBuf {
+/// Compiles `examples/c/NAME.c` with the system `cc` against the header and the shared library,
+/// and `libs` besides.
+fn compile(name: &str, libs: &[&str]) -> PathBuf {
     let lib = library_dir();
     let out = std::env::temp_dir().join(format!("softshadow-{name}-{}", std::process::id()));
     let status = Command::new("cc")
@@ -61,7 +62,12 @@ fn compile(name: &str) -> PathBuf {
         .arg(format!("-I{}", root().join("include").display()))
         .arg(format!("-L{}", lib.display()))
         .arg(format!("-Wl,-rpath,{}", lib.display()))
-        .args(["-lsoftshadow", "-lm", "-o"])
+        // DT_RPATH, not RUNPATH: searched before LD_LIBRARY_PATH, where cargo puts target/debug
+        // and with it any older libsoftshadow.so a `cargo build` left there.
+        .arg("-Wl,--disable-new-dtags")
+        .args(["-lsoftshadow", "-lm"])
+        .args(libs)
+        .arg("-o")
         .arg(&out)
         .status()
         .expect("the system C compiler `cc`");
@@ -88,7 +94,7 @@ fn read_pgm(path: &Path) -> (usize, usize, Vec<u16>) {
 /// box is lit and so is the box's top; every pass took time.
 #[test]
 fn the_c_game_loop_runs_and_shadows_where_physics_says() {
-    let exe = compile("game_loop");
+    let exe = compile("game_loop", &[]);
     let dir = std::env::temp_dir().join(format!("softshadow-game-loop-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let output = Command::new(&exe).arg(&dir).current_dir(root()).output().unwrap();
@@ -122,13 +128,55 @@ fn the_c_game_loop_runs_and_shadows_where_physics_says() {
     std::fs::remove_file(&exe).unwrap();
 }
 
+/// A C renderer's frames (its own instance and device under validation and synchronization
+/// validation, its own depth: the ground seen straight down, the box's top over it), recorded by
+/// `softshadow_record` into its command buffers and submitted by it. With the light at (4, 8, 0),
+/// the box's top edge at x = 0.5 falls on the ground at x = 0: V there is dark, the open ground
+/// and the box's top are lit, every pass took time (the import first), the layer reported no
+/// error, and the embedder's host allocator served the engine and got every block back.
+#[test]
+fn a_c_renderer_records_the_shadow_into_its_own_command_buffers() {
+    let exe = compile("embedder", &["-lvulkan"]);
+    let dir = std::env::temp_dir().join(format!("softshadow-embedder-out-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let output = Command::new(&exe).arg(&dir).current_dir(root()).output().unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    eprintln!("{stdout}{}", String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "embedder failed");
+    assert!(stdout.contains("; 0 validation errors"), "{stdout}");
+    let host = stdout.lines().find_map(|l| l.strip_prefix("host blocks through the callbacks: ")).expect("host blocks");
+    let made: usize = host.split(' ').next().unwrap().parse().unwrap();
+    assert!(made > 0 && host.ends_with(" 0 alive after the engine"), "the embedder's host allocator: {host}");
+    let passes: Vec<(&str, f64)> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("pass "))
+        .map(|l| {
+            let mut parts = l.split(' ');
+            (parts.next().unwrap(), parts.next().unwrap().parse().unwrap())
+        })
+        .collect();
+    let names: Vec<_> = passes.iter().map(|(n, _)| *n).collect();
+    assert_eq!(names, ["import", "shadow_map", "resolve"], "{stdout}");
+    assert!(passes.iter().all(|(_, ms)| *ms > 0.0), "{passes:?}");
+    let (w, h, v) = read_pgm(&dir.join("visibility.pgm"));
+    let at = |x: f32, z: f32| {
+        let (c, r) = (((x + 3.0) / 6.0 * w as f32) as usize, ((z + 3.0) / 6.0 * h as f32) as usize);
+        v[r * w + c] as f32 / 65535.0
+    };
+    assert!(at(0.25, 0.0) < 0.05, "V {} in the umbra", at(0.25, 0.0));
+    assert!(at(-2.0, 0.0) > 0.95 && at(2.5, 1.5) > 0.95, "V {} and {} in the open", at(-2.0, 0.0), at(2.5, 1.5));
+    assert!(at(1.0, 0.0) > 0.95, "V {} on the box's top", at(1.0, 0.0));
+    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_file(&exe).unwrap();
+}
+
 /// The bad-calls program: every bad call gets its status and a message. Under valgrind (when
 /// installed), a definitely lost block fails the run unless it was allocated inside the Vulkan
 /// loader or driver, which leak at exit by design (tests/valgrind.supp); our own leaks, in
 /// libsoftshadow.so or the C program, are not suppressed.
 #[test]
 fn every_bad_c_call_gets_an_error_code_and_a_message() {
-    let exe = compile("bad_calls");
+    let exe = compile("bad_calls", &[]);
     let valgrind = Command::new("valgrind").arg("--version").output().is_ok_and(|o| o.status.success());
     let mut command = if valgrind {
         let mut c = Command::new("valgrind");

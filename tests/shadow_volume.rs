@@ -156,7 +156,7 @@ fn a_near_plane_cutting_a_volume_breaks_neither_rule() {
     // The near plane's centre lies in the box's shadow; the eye does not.
     let bounds = s.objects.iter().fold(Aabb::EMPTY, |b, o| b.union(&o.mesh.bounds.transformed(&o.transform.matrix())));
     let c = &s.camera;
-    let cam = CameraProjection::new(c.position, c.target, c.up, c.projection, 1.0, &bounds);
+    let cam = CameraProjection::new(c.position, c.target, c.up, c.projection, 1.0, &bounds).unwrap();
     let near_centre = cam.frustum.corners[..4].iter().copied().sum::<Vec3>() / 4.0;
     let caster = Aabb { min: Vec3::new(-0.5, 0.0, -0.5), max: Vec3::new(0.5, 1.0, 0.5) };
     assert!(segment_meets_box(s.light.position, near_centre, &caster), "near plane at {near_centre}");

@@ -26,12 +26,14 @@ fn main() {
     let xvfb = common::xvfb::ensure_display();
     without_a_display_opening_a_window_names_the_variables();
     let mut app = AppWindow::open("softshadow window tests", W, H).expect("a window on the X server");
-    let checks: [(&str, Check); 5] = [
+    let checks: [(&str, Check); 6] = [
         ("a_moving_caster_is_presented_through_two_resizes", a_moving_caster_is_presented_through_two_resizes),
         ("a_presented_image_equals_the_headless_capture", a_presented_image_equals_the_headless_capture),
         ("the_present_mode_asked_for_is_taken", the_present_mode_asked_for_is_taken),
         ("fifo_keeps_the_cpu_within_the_frames_in_flight", fifo_keeps_the_cpu_within_the_frames_in_flight),
         ("softshadow_view_presents_and_writes_a_screenshot", softshadow_view_presents_and_writes_a_screenshot),
+        // Last: it brings a window manager, which then manages the window.
+        ("minimising_under_a_window_manager_never_errors", minimising_under_a_window_manager_never_errors),
     ];
     // A failed check must still stop the Xvfb: catch the panic, drop everything, then fail.
     let passed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
@@ -218,4 +220,77 @@ fn softshadow_view_presents_and_writes_a_screenshot(_: &mut AppWindow) {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("DISPLAY") && !stderr.contains("panicked"), "{stderr}");
+}
+
+/// The window's ICCCM state as the window manager set it (`Normal`, `Iconic`), read with xprop.
+fn wm_state(app: &AppWindow) -> Option<String> {
+    use winit::raw_window_handle::{HasWindowHandle, RawWindowHandle};
+    let id = match app.window().window_handle().expect("a window handle").as_raw() {
+        RawWindowHandle::Xlib(h) => h.window,
+        RawWindowHandle::Xcb(h) => h.window.get() as u64,
+        other => panic!("not an X11 window: {other:?}"),
+    };
+    let out = std::process::Command::new("xprop")
+        .args(["-id", &id.to_string(), "WM_STATE"])
+        .output()
+        .expect("xprop (x11-utils; scripts/install-deps.sh installs it)");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    text.lines().find_map(|l| l.trim().strip_prefix("window state: ").map(str::to_string))
+}
+
+/// Polls until the window manager reports `state`.
+fn wait_for_state(app: &mut AppWindow, state: &str) {
+    let start = Instant::now();
+    while wm_state(app).as_deref() != Some(state) {
+        app.poll();
+        assert!(start.elapsed() < Duration::from_secs(10), "the window never became {state}: {:?}", wm_state(app));
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Under a window manager (twm, started here; an X server's own one if it already has one),
+/// the window iconified and restored: every frame presents or is skipped, none errors, frames
+/// are presented again at the window's size once restored, and validation stays silent. On X11
+/// an iconified window keeps its size (the surface reports it), so Mesa's swapchain goes on
+/// presenting; a surface of no area (Windows' minimised windows) skips frames instead.
+fn minimising_under_a_window_manager_never_errors(app: &mut AppWindow) {
+    let config = std::env::temp_dir().join(format!("softshadow-twmrc-{}", std::process::id()));
+    // Placed without asking, no title bar, and fonts every X server has (twm wants "variable").
+    let fonts =
+        ["TitleFont", "ResizeFont", "MenuFont", "IconFont", "IconManagerFont"].map(|f| format!("{f} \"fixed\"\n"));
+    std::fs::write(&config, format!("RandomPlacement\nNoTitle\n{}", fonts.concat())).unwrap();
+    let mut twm = std::process::Command::new("twm")
+        .arg("-f")
+        .arg(&config)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("twm (scripts/install-deps.sh installs it)");
+    wait_for_state(app, "Normal");
+    let mut engine = windowed(app, WindowOptions::default());
+    let params = params(&scene(0.0));
+    for _ in 0..3 {
+        assert_eq!(engine.present(&scene(0.0), &params).unwrap(), Presented::Shown);
+    }
+    app.window().set_minimized(true);
+    wait_for_state(app, "Iconic");
+    let (mut shown, mut skipped) = (0, 0);
+    for frame in 0..20 {
+        app.poll();
+        match engine.present(&scene(frame as f32 * 0.05), &params).expect("a frame while iconified") {
+            Presented::Shown => shown += 1,
+            Presented::Skipped => skipped += 1,
+        }
+    }
+    println!("  iconified: {shown} frames presented, {skipped} skipped");
+    // winit restores through EWMH, which twm lacks: withdraw and map again, as ICCCM has it.
+    app.window().set_visible(false);
+    app.window().set_visible(true);
+    wait_for_state(app, "Normal");
+    let c = engine.present_and_capture(&scene(0.0), &params).unwrap().expect("presented once restored");
+    assert_eq!((c.width, c.height), (W, H));
+    common::finish(engine);
+    let _ = twm.kill();
+    let _ = twm.wait();
+    std::fs::remove_file(&config).unwrap();
 }

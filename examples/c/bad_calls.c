@@ -21,6 +21,12 @@ static void expect(const char *what, softshadow_status got, softshadow_status wa
 
 #define EXPECT(call, want) expect(#call, (call), (want))
 
+/* VkAllocationCallbacks' layout, without including Vulkan's header. */
+typedef struct {
+    void *pUserData;
+    void *pfnAllocation, *pfnReallocation, *pfnFree, *pfnInternalAllocation, *pfnInternalFree;
+} allocation_callbacks;
+
 static const float TRIANGLE[9] = {0, 0, 0, 1, 0, 0, 0, 0, 1};
 static const uint32_t INDICES[3] = {0, 1, 2};
 static const uint32_t OUT_OF_RANGE[3] = {0, 1, 99};
@@ -66,6 +72,14 @@ int main(void) {
     EXPECT(softshadow_engine_create_from_vulkan(NULL, &engine), SOFTSHADOW_ERROR_NULL);
     softshadow_vulkan no_device = {0};
     EXPECT(softshadow_engine_create_from_vulkan(&no_device, &engine), SOFTSHADOW_ERROR_NULL);
+    /* Allocation callbacks without pfnFree: refused before any handle is used. */
+    int dummy = 0;
+    allocation_callbacks no_free = {.pfnAllocation = &dummy, .pfnReallocation = &dummy};
+    softshadow_vulkan bad_callbacks = {
+        .get_instance_proc_addr = &dummy, .instance = &dummy, .physical_device = &dummy, .device = &dummy,
+        .allocation_callbacks = &no_free,
+    };
+    EXPECT(softshadow_engine_create_from_vulkan(&bad_callbacks, &engine), SOFTSHADOW_ERROR_INVALID);
 
     softshadow_object object = {
         .positions = TRIANGLE,

@@ -3,7 +3,7 @@
 //! with −up' (row 0 at the top). Depth is reversed (near 1, far 0) for float precision, and the
 //! near and far planes are fitted to the scene's bounds every frame, never hard-coded.
 
-use glam::{DMat4, DVec4, Mat4, Vec2, Vec3};
+use glam::{DMat4, DVec4, Mat4, Vec2, Vec3, Vec4};
 
 use super::{Aabb, Hexahedron};
 
@@ -19,6 +19,13 @@ pub enum Projection {
 /// A camera's matrices for one frame.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraProjection {
+    /// World → view and view → clip, in single precision as a renderer holds them: the same
+    /// matrices handed to [`CameraProjection::from_matrices`] give this projection bit for bit.
+    pub view: Mat4,
+    pub projection: Mat4,
+    /// The near and far distances along the view axis the view volume spans.
+    pub near: f32,
+    pub far: f32,
     pub view_proj: Mat4,
     pub inv_view_proj: Mat4,
     pub position: Vec3,
@@ -41,8 +48,16 @@ fn reverse_z_perspective(tan_half_fov_y: f64, aspect: f64, near: f64, far: f64) 
 }
 
 impl CameraProjection {
-    /// `up` must not be parallel to `target − position` (the scene loader checks).
-    pub fn new(position: Vec3, target: Vec3, up: Vec3, projection: Projection, aspect: f32, scene: &Aabb) -> Self {
+    /// `up` must not be parallel to `target − position` (the scene loader checks). Errors as
+    /// [`CameraProjection::from_matrices`] does, for a camera no finite matrices describe.
+    pub fn new(
+        position: Vec3,
+        target: Vec3,
+        up: Vec3,
+        projection: Projection,
+        aspect: f32,
+        scene: &Aabb,
+    ) -> Result<Self, String> {
         let (pos, forward) = (position.as_dvec3(), (target - position).as_dvec3().normalize());
         let right = forward.cross(up.as_dvec3()).normalize();
         let true_up = right.cross(forward);
@@ -55,7 +70,7 @@ impl CameraProjection {
         let depths = scene.corners().map(|c| forward.dot(c.as_dvec3() - pos));
         let (dmin, dmax) = depths.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
         let aspect = aspect as f64;
-        let proj = match projection {
+        let (proj, near, far) = match projection {
             Projection::Perspective { fov_y_deg } => {
                 let far = if dmax > 0.0 { dmax * 1.01 } else { 1.0 };
                 let tan_half = ((fov_y_deg as f64).to_radians() * 0.5).tan();
@@ -65,41 +80,27 @@ impl CameraProjection {
                 let gap = (scene.min.as_dvec3() - pos).max(pos - scene.max.as_dvec3()).max(glam::DVec3::ZERO);
                 let cos_diagonal = 1.0 / (1.0 + tan_half * tan_half * (1.0 + aspect * aspect)).sqrt();
                 let near = (dmin * 0.99).max(gap.length() * cos_diagonal * 0.99).max(far * 1e-9);
-                reverse_z_perspective(tan_half, aspect, near, far)
+                // Beyond that the scene lies wholly outside the view: any thin volume will do.
+                let near = near.min(far * 0.999);
+                (reverse_z_perspective(tan_half, aspect, near, far), near, far)
             }
             Projection::Orthographic { half_height } => {
                 let pad = ((dmax - dmin) * 0.01).max(1e-6 * dmax.abs().max(1.0));
                 let (near, far) = (dmin - pad, dmax + pad);
                 let h = half_height as f64;
-                DMat4::from_cols(
+                let proj = DMat4::from_cols(
                     DVec4::new(1.0 / (h * aspect), 0.0, 0.0, 0.0),
                     DVec4::new(0.0, -1.0 / h, 0.0, 0.0),
                     DVec4::new(0.0, 0.0, -1.0 / (far - near), 0.0),
                     DVec4::new(0.0, 0.0, far / (far - near), 1.0),
-                )
+                );
+                (proj, near, far)
             }
         };
-        let view_proj = proj * view;
-        // Inverted in double precision: positions rebuilt from depth stay exact at large scales.
-        let inv = view_proj.inverse();
-        let corners = std::array::from_fn(|i| {
-            let ndc = DVec4::new(
-                if i & 1 == 0 { -1.0 } else { 1.0 },
-                if i & 2 == 0 { -1.0 } else { 1.0 },
-                if i & 4 == 0 { 1.0 } else { 0.0 },
-                1.0,
-            );
-            let w = inv * ndc;
-            (w.truncate() / w.w).as_vec3()
-        });
-        CameraProjection {
-            view_proj: view_proj.as_mat4(),
-            inv_view_proj: inv.as_mat4(),
-            position,
-            forward: forward.as_vec3(),
-            inv64: inv,
-            frustum: Hexahedron { corners },
-        }
+        // Through the embedder's constructor, from the matrices rounded as an embedder holds
+        // them: an embedder passing the same camera gets the same frame, bit for bit.
+        let (near, far) = (near as f32, far as f32);
+        Self::from_matrices(view.as_mat4(), proj.as_mat4(), true, near, far)
     }
 
     /// An embedder's camera: `view` (world → view) and `projection` (view → Vulkan clip, y
@@ -115,11 +116,14 @@ impl CameraProjection {
         if !(near.is_finite() && far.is_finite() && far > near) {
             return Err(format!("the camera's near ({near}) and far ({far}) must be finite with near < far"));
         }
-        let (view64, proj) = (view.as_dmat4(), projection.as_dmat4());
+        let view64 = view.as_dmat4();
         // z' = w − z turns forward-Z clip depth d into 1 − d.
-        let flip =
-            DMat4::from_cols(DVec4::X, DVec4::Y, DVec4::new(0.0, 0.0, -1.0, 0.0), DVec4::new(0.0, 0.0, 1.0, 1.0));
-        let view_proj = if reverse_z { proj * view64 } else { flip * proj * view64 };
+        let flip = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::new(0.0, 0.0, -1.0, 0.0), Vec4::new(0.0, 0.0, 1.0, 1.0));
+        // The product in single precision, as the embedder multiplies it to rasterize its depth:
+        // positions are rebuilt through the very matrix that placed them (the double-precision
+        // product rounds differently in the last bit, which moved PCF's V by a few LSB; issue 15).
+        let product = projection * view;
+        let view_proj = if reverse_z { product } else { flip * product }.as_dmat4();
         let det = view_proj.determinant();
         if !(det.is_finite() && det.abs() > 1e-300) || view64.determinant().abs() < 1e-300 {
             return Err("the camera's view or projection matrix is singular".into());
@@ -149,6 +153,10 @@ impl CameraProjection {
             unproject(x, y, if i & 4 == 0 { z_near } else { z_far }).as_vec3()
         });
         Ok(CameraProjection {
+            view,
+            projection,
+            near,
+            far,
             view_proj: view_proj.as_mat4(),
             inv_view_proj: inv.as_mat4(),
             position: position.as_vec3(),
@@ -192,7 +200,8 @@ mod tests {
     #[test]
     fn right_is_plus_x_and_up_is_minus_y_in_ndc() {
         for projection in [Projection::Perspective { fov_y_deg: 45.0 }, Projection::Orthographic { half_height: 2.0 }] {
-            let cam = CameraProjection::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene());
+            let cam = CameraProjection::new(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene())
+                .unwrap();
             // Looking down −Z with +Y up, world +X is to the right and +Y is the top row.
             assert!(ndc(&cam.view_proj, Vec3::X * 0.5).x > 0.0);
             assert!(ndc(&cam.view_proj, Vec3::Y * 0.5).y < 0.0);
@@ -206,7 +215,8 @@ mod tests {
     fn an_embedders_matrices_give_the_same_camera() {
         let (eye, target) = (Vec3::new(3.0, 4.0, 5.0), Vec3::ZERO);
         let ours =
-            CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene());
+            CameraProjection::new(eye, target, Vec3::Y, Projection::Perspective { fov_y_deg: 60.0 }, 1.5, &scene())
+                .unwrap();
         // A right-handed look-at (view down −z) and [0, 1]-depth perspectives, y flipped for
         // Vulkan: depth 0 at `z0`, 1 at `z1`.
         let (f, s) = ((target - eye).normalize(), (target - eye).normalize().cross(Vec3::Y).normalize());
@@ -252,12 +262,29 @@ mod tests {
             Projection::Perspective { fov_y_deg: 60.0 },
             1.5,
             &scene(),
-        );
+        )
+        .unwrap();
         let near = ndc(&cam.view_proj, Vec3::splat(1.0)).z;
         let far = ndc(&cam.view_proj, Vec3::splat(-1.0)).z;
         assert!(near > far && (0.0..=1.0).contains(&near) && (0.0..=1.0).contains(&far));
         let p = Vec3::new(0.3, -0.2, 0.1);
         let back = cam.inv_view_proj.project_point3(ndc(&cam.view_proj, p));
         assert!((back - p).length() < 1e-4);
+    }
+
+    /// The engine's camera is an embedder's camera: its own single-precision matrices and planes,
+    /// handed back, give the same matrices and view volume bit for bit.
+    #[test]
+    fn the_engines_matrices_handed_back_give_the_same_camera() {
+        for projection in [Projection::Perspective { fov_y_deg: 45.0 }, Projection::Orthographic { half_height: 2.0 }] {
+            let ours = CameraProjection::new(Vec3::new(0.0, 5.0, 6.0), Vec3::ZERO, Vec3::Y, projection, 1.0, &scene())
+                .unwrap();
+            let back = CameraProjection::from_matrices(ours.view, ours.projection, true, ours.near, ours.far).unwrap();
+            assert_eq!((back.view_proj, back.inv_view_proj), (ours.view_proj, ours.inv_view_proj));
+            assert_eq!(
+                (back.position, back.forward, back.frustum.corners),
+                (ours.position, ours.forward, ours.frustum.corners)
+            );
+        }
     }
 }

@@ -76,6 +76,10 @@ pub struct EmbedderHandles {
     /// The Vulkan 1.0 features passed to `vkCreateDevice`, at least
     /// [`required_core_features`](super::required_core_features).
     pub enabled_core_features: vk::PhysicalDeviceFeatures,
+    /// The embedder's host allocator, passed to every `vkCreate*` and `vkDestroy*` of the engine's
+    /// own objects (its functions and user data must outlive the engine). Device memory comes
+    /// from gpu-allocator, whose `vkAllocateMemory` and `vkFreeMemory` pass none.
+    pub allocation_callbacks: Option<vk::AllocationCallbacks<'static>>,
 }
 
 /// The Vulkan plumbing every pass uses, on a device of its own or the embedder's; destroyed last.
@@ -92,6 +96,8 @@ pub struct Context {
     pub(crate) queue: vk::Queue,
     pub(crate) queue_family: u32,
     ownership: Ownership,
+    /// The embedder's host allocator, if it gave one.
+    host_allocator: Option<vk::AllocationCallbacks<'static>>,
     // `None` only after `destroy`.
     allocator: Option<Mutex<Allocator>>,
     live_allocations: AtomicUsize,
@@ -120,6 +126,7 @@ struct Parts {
     queue_index: u32,
     depth_stencil_format: vk::Format,
     ownership: Ownership,
+    host_allocator: Option<vk::AllocationCallbacks<'static>>,
     log: Box<ValidationLog>,
 }
 
@@ -224,6 +231,7 @@ impl Context {
             queue_index: 0,
             depth_stencil_format: picked.depth_stencil_format,
             ownership: Ownership::Owned,
+            host_allocator: None,
             log,
         })
     }
@@ -245,6 +253,7 @@ impl Context {
             queue_index,
             enabled_features,
             enabled_core_features,
+            allocation_callbacks,
         } = handles;
         let depth_stencil_format = check_embedder_device(
             &instance,
@@ -271,6 +280,7 @@ impl Context {
             queue_index,
             depth_stencil_format,
             ownership: Ownership::Borrowed,
+            host_allocator: allocation_callbacks,
             log: Box::default(),
         })
     }
@@ -310,6 +320,7 @@ impl Context {
             device,
             queue_family: parts.queue_family,
             ownership: parts.ownership,
+            host_allocator: parts.host_allocator,
             allocator: None,
             live_allocations: AtomicUsize::new(0),
             nearest_sampler: vk::Sampler::null(),
@@ -336,7 +347,8 @@ impl Context {
             .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
             .max_lod(0.0);
-        ctx.nearest_sampler = unsafe { ctx.device.create_sampler(&sampler_ci, None) }.vk("vkCreateSampler")?;
+        ctx.nearest_sampler =
+            unsafe { ctx.device.create_sampler(&sampler_ci, ctx.host_allocator()) }.vk("vkCreateSampler")?;
         ctx.name(ctx.nearest_sampler, "nearest clamp sampler");
         Ok(ctx)
     }
@@ -370,6 +382,11 @@ impl Context {
     /// [`from_handles`](Context::from_handles), whose messages go to the embedder's messenger.
     pub fn validation_errors(&self) -> Vec<String> {
         self.log.errors()
+    }
+
+    /// The host allocator to pass to `vkCreate*` and `vkDestroy*`: the embedder's, or none.
+    pub(crate) fn host_allocator(&self) -> Option<&vk::AllocationCallbacks<'static>> {
+        self.host_allocator.as_ref()
     }
 
     /// GPU allocations alive now: a render loop must not make this grow.
@@ -427,7 +444,7 @@ impl Context {
         unsafe {
             // Nothing to do on failure: our objects are being torn down regardless.
             let _ = self.device.queue_wait_idle(self.queue);
-            self.device.destroy_sampler(self.nearest_sampler, None);
+            self.device.destroy_sampler(self.nearest_sampler, self.host_allocator());
             self.allocator = None;
             if self.ownership == Ownership::Owned {
                 self.device.destroy_device(None);
@@ -483,8 +500,8 @@ mod tests {
         assert!(ctx.validation_errors().is_empty());
         // VUID-VkBufferCreateInfo-size-00912: size must be greater than 0.
         let ci = vk::BufferCreateInfo::default().size(0).usage(vk::BufferUsageFlags::UNIFORM_BUFFER);
-        if let Ok(buffer) = unsafe { ctx.device.create_buffer(&ci, None) } {
-            unsafe { ctx.device.destroy_buffer(buffer, None) };
+        if let Ok(buffer) = unsafe { ctx.device.create_buffer(&ci, ctx.host_allocator()) } {
+            unsafe { ctx.device.destroy_buffer(buffer, ctx.host_allocator()) };
         }
         ctx.destroy();
         let errors = ctx.validation_errors();

@@ -76,7 +76,8 @@ impl FrameRing {
         let pool_ci = vk::CommandPoolCreateInfo::default()
             .queue_family_index(ctx.queue_family)
             .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
-        let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
+        let pool =
+            unsafe { ctx.device.create_command_pool(&pool_ci, ctx.host_allocator()) }.vk("vkCreateCommandPool")?;
         let mut ring = FrameRing { pool, slots: Vec::new(), next: 0, gpu_origin: None, external: None };
         if let Err(e) = ring.fill(ctx) {
             ring.destroy(ctx);
@@ -94,11 +95,11 @@ impl FrameRing {
         for cmd in cmds {
             // Signalled, so the first wait on each slot returns at once.
             let fence_ci = vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED);
-            let fence = unsafe { ctx.device.create_fence(&fence_ci, None) }.vk("vkCreateFence")?;
+            let fence = unsafe { ctx.device.create_fence(&fence_ci, ctx.host_allocator()) }.vk("vkCreateFence")?;
             let timer = match PassTimer::new(ctx) {
                 Ok(t) => t,
                 Err(e) => {
-                    unsafe { ctx.device.destroy_fence(fence, None) };
+                    unsafe { ctx.device.destroy_fence(fence, ctx.host_allocator()) };
                     return Err(e);
                 }
             };
@@ -252,10 +253,10 @@ impl FrameRing {
             external.buffer.destroy(ctx);
         }
         for s in self.slots {
-            unsafe { ctx.device.destroy_fence(s.fence, None) };
+            unsafe { ctx.device.destroy_fence(s.fence, ctx.host_allocator()) };
             s.timer.destroy(ctx);
         }
-        unsafe { ctx.device.destroy_command_pool(self.pool, None) };
+        unsafe { ctx.device.destroy_command_pool(self.pool, ctx.host_allocator()) };
     }
 }
 

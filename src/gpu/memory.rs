@@ -25,7 +25,7 @@ impl Buffer {
     ) -> Result<Self> {
         let size = size.max(4);
         let ci = vk::BufferCreateInfo::default().size(size).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
-        let buffer = unsafe { ctx.device.create_buffer(&ci, None) }.vk("vkCreateBuffer")?;
+        let buffer = unsafe { ctx.device.create_buffer(&ci, ctx.host_allocator()) }.vk("vkCreateBuffer")?;
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(buffer) };
         let desc = AllocationCreateDesc {
             name,
@@ -37,7 +37,7 @@ impl Buffer {
         let allocation = match ctx.allocate(&desc) {
             Ok(a) => a,
             Err(e) => {
-                unsafe { ctx.device.destroy_buffer(buffer, None) };
+                unsafe { ctx.device.destroy_buffer(buffer, ctx.host_allocator()) };
                 return Err(e);
             }
         };
@@ -68,7 +68,7 @@ impl Buffer {
     }
 
     pub fn destroy(mut self, ctx: &Context) {
-        unsafe { ctx.device.destroy_buffer(self.buffer, None) };
+        unsafe { ctx.device.destroy_buffer(self.buffer, ctx.host_allocator()) };
         if let Some(a) = self.allocation.take() {
             ctx.free(a);
         }

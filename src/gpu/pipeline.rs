@@ -246,8 +246,9 @@ impl Pipeline {
                 .name(c"main")
                 .specialization_info(&info);
             let ci = vk::ComputePipelineCreateInfo::default().stage(stage).layout(pipeline.layout);
-            let created = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[ci], None) };
-            unsafe { ctx.device.destroy_shader_module(module, None) };
+            let created =
+                unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[ci], ctx.host_allocator()) };
+            unsafe { ctx.device.destroy_shader_module(module, ctx.host_allocator()) };
             pipeline.pipeline =
                 created.map_err(|(_, result)| Error::Vulkan { call: "vkCreateComputePipelines", result })?[0];
             Ok(())
@@ -300,8 +301,8 @@ impl Pipeline {
         let set_ci = vk::DescriptorSetLayoutCreateInfo::default()
             .flags(vk::DescriptorSetLayoutCreateFlags::PUSH_DESCRIPTOR_KHR)
             .bindings(&layout_bindings);
-        let set_layout =
-            unsafe { ctx.device.create_descriptor_set_layout(&set_ci, None) }.vk("vkCreateDescriptorSetLayout")?;
+        let set_layout = unsafe { ctx.device.create_descriptor_set_layout(&set_ci, ctx.host_allocator()) }
+            .vk("vkCreateDescriptorSetLayout")?;
         Ok(Pipeline {
             name,
             pipeline: vk::Pipeline::null(),
@@ -340,7 +341,7 @@ impl Pipeline {
         let frag = match shader_module(ctx, desc.fragment.words) {
             Ok(f) => f,
             Err(e) => {
-                unsafe { d.destroy_shader_module(vert, None) };
+                unsafe { d.destroy_shader_module(vert, ctx.host_allocator()) };
                 return Err(e);
             }
         };
@@ -432,10 +433,10 @@ impl Pipeline {
             .dynamic_state(&dynamic_state)
             .layout(self.layout)
             .push_next(&mut rendering);
-        let created = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[ci], None) };
+        let created = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[ci], ctx.host_allocator()) };
         unsafe {
-            d.destroy_shader_module(vert, None);
-            d.destroy_shader_module(frag, None);
+            d.destroy_shader_module(vert, ctx.host_allocator());
+            d.destroy_shader_module(frag, ctx.host_allocator());
         }
         self.pipeline = created.map_err(|(_, result)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result })?[0];
         Ok(())
@@ -497,9 +498,9 @@ impl Pipeline {
 
     pub fn destroy(self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device.destroy_descriptor_set_layout(self.set_layout, None);
+            ctx.device.destroy_pipeline(self.pipeline, ctx.host_allocator());
+            ctx.device.destroy_pipeline_layout(self.layout, ctx.host_allocator());
+            ctx.device.destroy_descriptor_set_layout(self.set_layout, ctx.host_allocator());
         }
     }
 }
@@ -589,12 +590,12 @@ fn specializations(name: &str, stages: &[Stage<'_>], constants: &[(&'static str,
 fn pipeline_layout(ctx: &Context, set_layout: vk::DescriptorSetLayout) -> Result<vk::PipelineLayout> {
     let set_layouts = [set_layout];
     let layout_ci = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
-    unsafe { ctx.device.create_pipeline_layout(&layout_ci, None) }.vk("vkCreatePipelineLayout")
+    unsafe { ctx.device.create_pipeline_layout(&layout_ci, ctx.host_allocator()) }.vk("vkCreatePipelineLayout")
 }
 
 fn shader_module(ctx: &Context, words: &[u32]) -> Result<vk::ShaderModule> {
     let ci = vk::ShaderModuleCreateInfo::default().code(words);
-    unsafe { ctx.device.create_shader_module(&ci, None) }.vk("vkCreateShaderModule")
+    unsafe { ctx.device.create_shader_module(&ci, ctx.host_allocator()) }.vk("vkCreateShaderModule")
 }
 
 #[cfg(test)]
@@ -615,7 +616,7 @@ mod tests {
 
         let pipeline = Pipeline::fullscreen(&ctx, &Fullscreen::new("resolve", resolve, vk::Format::R16_UNORM)).unwrap();
         let pool_ci = vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family);
-        let pool = unsafe { ctx.device.create_command_pool(&pool_ci, None) }.unwrap();
+        let pool = unsafe { ctx.device.create_command_pool(&pool_ci, ctx.host_allocator()) }.unwrap();
         let alloc = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
         let cmd = unsafe { ctx.device.allocate_command_buffers(&alloc) }.unwrap()[0];
         let buffer = Descriptor::Buffer(vk::DescriptorBufferInfo::default());
@@ -623,7 +624,7 @@ mod tests {
         assert!(e.contains("4 inputs") && e.contains("5 bindings") && e.contains("shadow_map"), "{e}");
         let e = pipeline.bind(&ctx, cmd, &[buffer; 5]).unwrap_err().to_string();
         assert!(e.contains("binding 2 `camera_depth`") && e.contains("given a buffer"), "{e}");
-        unsafe { ctx.device.destroy_command_pool(pool, None) };
+        unsafe { ctx.device.destroy_command_pool(pool, ctx.host_allocator()) };
         pipeline.destroy(&ctx);
         let mut ctx = ctx;
         ctx.destroy();

@@ -214,10 +214,10 @@ impl Swapchain {
             .present_mode(self.present_mode)
             .clipped(true)
             .old_swapchain(old);
-        let handle = unsafe { self.loader.create_swapchain(&ci, None) }.vk("vkCreateSwapchainKHR")?;
+        let handle = unsafe { self.loader.create_swapchain(&ci, ctx.host_allocator()) }.vk("vkCreateSwapchainKHR")?;
         self.destroy_images(ctx);
         if old != vk::SwapchainKHR::null() {
-            unsafe { self.loader.destroy_swapchain(old, None) };
+            unsafe { self.loader.destroy_swapchain(old, ctx.host_allocator()) };
         }
         self.handle = handle;
         ctx.name(handle, "swapchain");
@@ -291,7 +291,7 @@ impl Swapchain {
             image.destroy(ctx);
         }
         for s in self.rendered.drain(..) {
-            unsafe { ctx.device.destroy_semaphore(s, None) };
+            unsafe { ctx.device.destroy_semaphore(s, ctx.host_allocator()) };
         }
     }
 
@@ -299,14 +299,15 @@ impl Swapchain {
     pub fn destroy(mut self, ctx: &Context) {
         self.destroy_images(ctx);
         for s in self.acquired.drain(..) {
-            unsafe { ctx.device.destroy_semaphore(s, None) };
+            unsafe { ctx.device.destroy_semaphore(s, ctx.host_allocator()) };
         }
         if self.handle != vk::SwapchainKHR::null() {
-            unsafe { self.loader.destroy_swapchain(self.handle, None) };
+            unsafe { self.loader.destroy_swapchain(self.handle, ctx.host_allocator()) };
         }
     }
 }
 
 fn semaphore(ctx: &Context) -> Result<vk::Semaphore> {
-    unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }.vk("vkCreateSemaphore")
+    unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), ctx.host_allocator()) }
+        .vk("vkCreateSemaphore")
 }

@@ -103,7 +103,7 @@ impl Target {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        let image = unsafe { ctx.device.create_image(&ci, None) }.vk("vkCreateImage")?;
+        let image = unsafe { ctx.device.create_image(&ci, ctx.host_allocator()) }.vk("vkCreateImage")?;
         let requirements = unsafe { ctx.device.get_image_memory_requirements(image) };
         let alloc_desc = AllocationCreateDesc {
             name: desc.name,
@@ -219,10 +219,10 @@ impl Target {
     pub fn destroy(mut self, ctx: &Context) {
         unsafe {
             if self.owns != Owns::Nothing {
-                ctx.device.destroy_image_view(self.view, None);
+                ctx.device.destroy_image_view(self.view, ctx.host_allocator());
             }
             if self.owns == Owns::Everything {
-                ctx.device.destroy_image(self.image, None);
+                ctx.device.destroy_image(self.image, ctx.host_allocator());
             }
         }
         if let Some(a) = self.allocation.take() {
@@ -253,7 +253,7 @@ fn view_of(ctx: &Context, image: vk::Image, desc: &TargetDesc, aspect: vk::Image
         .view_type(vk::ImageViewType::TYPE_2D)
         .format(desc.format)
         .subresource_range(subresource(aspect));
-    let view = unsafe { ctx.device.create_image_view(&view_ci, None) }.vk("vkCreateImageView")?;
+    let view = unsafe { ctx.device.create_image_view(&view_ci, ctx.host_allocator()) }.vk("vkCreateImageView")?;
     ctx.name(view, desc.name);
     Ok(view)
 }

@@ -34,7 +34,7 @@ pub struct PassTimer {
 impl PassTimer {
     pub fn new(ctx: &Context) -> Result<Self> {
         let ci = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(MAX_PASSES * 2);
-        let pool = unsafe { ctx.device.create_query_pool(&ci, None) }.vk("vkCreateQueryPool")?;
+        let pool = unsafe { ctx.device.create_query_pool(&ci, ctx.host_allocator()) }.vk("vkCreateQueryPool")?;
         ctx.name(pool, "pass timestamps");
         Ok(PassTimer { pool, names: Vec::new(), open: false, recorded: false })
     }
@@ -127,7 +127,7 @@ impl PassTimer {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+        unsafe { ctx.device.destroy_query_pool(self.pool, ctx.host_allocator()) };
     }
 }
 
@@ -150,7 +150,7 @@ pub struct Milestones {
 impl Milestones {
     pub fn new(ctx: &Context, capacity: u32) -> Result<Self> {
         let ci = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(capacity);
-        let pool = unsafe { ctx.device.create_query_pool(&ci, None) }.vk("vkCreateQueryPool")?;
+        let pool = unsafe { ctx.device.create_query_pool(&ci, ctx.host_allocator()) }.vk("vkCreateQueryPool")?;
         ctx.name(pool, "milestones");
         Ok(Milestones { pool, capacity, written: 0 })
     }
@@ -188,7 +188,7 @@ impl Milestones {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+        unsafe { ctx.device.destroy_query_pool(self.pool, ctx.host_allocator()) };
     }
 }
 

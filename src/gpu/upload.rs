@@ -81,7 +81,7 @@ fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Res
     let pool_ci = vk::CommandPoolCreateInfo::default()
         .queue_family_index(ctx.queue_family)
         .flags(vk::CommandPoolCreateFlags::TRANSIENT);
-    let pool = unsafe { d.create_command_pool(&pool_ci, None) }.vk("vkCreateCommandPool")?;
+    let pool = unsafe { d.create_command_pool(&pool_ci, ctx.host_allocator()) }.vk("vkCreateCommandPool")?;
     let run = || -> Result<()> {
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
@@ -92,17 +92,18 @@ fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Res
         unsafe { d.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
         record(cmd);
         unsafe { d.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
-        let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.vk("vkCreateFence")?;
+        let fence =
+            unsafe { d.create_fence(&vk::FenceCreateInfo::default(), ctx.host_allocator()) }.vk("vkCreateFence")?;
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         let waited = unsafe { d.queue_submit2(ctx.queue, &submit, fence) }
             .vk("vkQueueSubmit2")
             .and_then(|()| unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences"));
-        unsafe { d.destroy_fence(fence, None) };
+        unsafe { d.destroy_fence(fence, ctx.host_allocator()) };
         waited
     };
     let result = run();
-    unsafe { d.destroy_command_pool(pool, None) };
+    unsafe { d.destroy_command_pool(pool, ctx.host_allocator()) };
     result
 }
 

@@ -30,11 +30,12 @@ pub(super) fn record_copies(
     color: Option<&Target>,
     dst: &Buffer,
 ) {
-    let extent = t.color.extent();
+    let extent = t.extent();
     let pixels = extent.width as u64 * extent.height as u64;
     let mut offset = 0;
     let bytes = pixel_bytes(t.visibility.desc.format);
-    for (target, bytes) in [color.unwrap_or(&t.color), &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
+    let own = &t.shaded.as_ref().expect("a captured frame is the engine's own").color;
+    for (target, bytes) in [color.unwrap_or(own), &t.depth, &t.normal, &t.visibility].into_iter().zip(bytes) {
         copy_to_buffer(ctx, cmd, target, dst, &[target.whole_copy(offset)]);
         offset += pixels * bytes;
     }

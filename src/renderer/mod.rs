@@ -145,49 +145,85 @@ pub struct CameraTargets {
     pub depth: Target,
     /// Facet normal (facing the camera) and shadow role: what techniques read.
     pub normal: Target,
+    pub visibility: Target,
+    /// What only the engine's own prepass and composite use: an engine that only records into
+    /// an embedder's frames never makes them.
+    pub shaded: Option<ShadedTargets>,
+}
+
+/// The targets of the engine's own shading.
+pub struct ShadedTargets {
     /// Interpolated normal: what the composite shades with.
     pub shading: Target,
     pub albedo: Target,
-    pub visibility: Target,
     pub color: Target,
+}
+
+/// Makes every target of `descs`, or none.
+fn targets<const N: usize>(ctx: &Context, descs: [TargetDesc; N]) -> Result<[Target; N]> {
+    let mut made = Vec::new();
+    for desc in descs {
+        match Target::new(ctx, desc) {
+            Ok(t) => made.push(t),
+            Err(e) => {
+                made.into_iter().for_each(|t| t.destroy(ctx));
+                return Err(e);
+            }
+        }
+    }
+    Ok(<[Target; N]>::try_from(made).ok().expect("one per desc"))
+}
+
+impl ShadedTargets {
+    fn new(ctx: &Context, extent: vk::Extent2D) -> Result<Self> {
+        let (w, h) = (extent.width, extent.height);
+        let [shading, albedo, color] = targets(
+            ctx,
+            [
+                TargetDesc::color("camera shading normal", SHADING_FORMAT, w, h),
+                TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
+                TargetDesc::color("color", COLOR_FORMAT, w, h).usage(vk::ImageUsageFlags::TRANSFER_SRC),
+            ],
+        )?;
+        Ok(ShadedTargets { shading, albedo, color })
+    }
+
+    fn destroy(self, ctx: &Context) {
+        [self.shading, self.albedo, self.color].into_iter().for_each(|t| t.destroy(ctx));
+    }
 }
 
 impl CameraTargets {
     fn new(ctx: &Context, w: u32, h: u32, visibility: vk::Format) -> Result<Self> {
         let sampled = vk::ImageUsageFlags::SAMPLED;
         let readback = vk::ImageUsageFlags::TRANSFER_SRC;
-        let descs = [
-            TargetDesc::depth("camera depth", w, h).usage(sampled | readback),
-            TargetDesc::color("camera normal", NORMAL_FORMAT, w, h).usage(readback),
-            TargetDesc::color("camera shading normal", SHADING_FORMAT, w, h),
-            TargetDesc::color("camera albedo", ALBEDO_FORMAT, w, h),
-            // CPU techniques (`raytrace`, `parker`) copy V in.
-            TargetDesc::color("visibility", visibility, w, h).usage(readback | vk::ImageUsageFlags::TRANSFER_DST),
-            TargetDesc::color("color", COLOR_FORMAT, w, h).usage(readback),
-        ];
-        let mut made = Vec::new();
-        for desc in descs {
-            match Target::new(ctx, desc) {
-                Ok(t) => made.push(t),
-                Err(e) => {
-                    made.into_iter().for_each(|t| t.destroy(ctx));
-                    return Err(e);
-                }
-            }
-        }
-        let [depth, normal, shading, albedo, visibility, color] =
-            <[Target; 6]>::try_from(made).ok().expect("six targets");
-        Ok(CameraTargets { depth, normal, shading, albedo, visibility, color })
+        let [depth, normal, visibility] = targets(
+            ctx,
+            [
+                TargetDesc::depth("camera depth", w, h).usage(sampled | readback),
+                TargetDesc::color("camera normal", NORMAL_FORMAT, w, h).usage(readback),
+                // CPU techniques (`raytrace`, `parker`) copy V in.
+                TargetDesc::color("visibility", visibility, w, h).usage(readback | vk::ImageUsageFlags::TRANSFER_DST),
+            ],
+        )?;
+        Ok(CameraTargets { depth, normal, visibility, shaded: None })
     }
 
     fn extent(&self) -> vk::Extent2D {
-        self.color.extent()
+        self.depth.extent()
+    }
+
+    /// The shading targets, made on first use.
+    fn ensure_shaded(&mut self, ctx: &Context) -> Result<&mut ShadedTargets> {
+        if self.shaded.is_none() {
+            self.shaded = Some(ShadedTargets::new(ctx, self.extent())?);
+        }
+        Ok(self.shaded.as_mut().expect("made above"))
     }
 
     fn destroy(self, ctx: &Context) {
-        for t in [self.depth, self.normal, self.shading, self.albedo, self.visibility, self.color] {
-            t.destroy(ctx);
-        }
+        [self.depth, self.normal, self.visibility].into_iter().for_each(|t| t.destroy(ctx));
+        self.shaded.into_iter().for_each(|s| s.destroy(ctx));
     }
 }
 
@@ -390,6 +426,7 @@ impl Engine {
         let prepared = self.data.prepare(ctx, &frame, scene, None, vk::Extent2D { width: w, height: h })?;
         clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
+        targets.ensure_shaded(ctx)?;
         self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, prepared.inputs(), &prepared.draws)?;
         clock.mark("prepass");
         let (_, technique) = self.technique.as_mut().expect("ensured");
@@ -419,7 +456,11 @@ impl Engine {
                 ctx,
                 frame.cmd,
                 &mut [
-                    (into.as_deref_mut().unwrap_or(&mut targets.color), Access::COPY_READ, false),
+                    (
+                        into.as_deref_mut().unwrap_or(&mut targets.shaded.as_mut().expect("ensured").color),
+                        Access::COPY_READ,
+                        false,
+                    ),
                     (&mut targets.depth, Access::COPY_READ, false),
                     (&mut targets.normal, Access::COPY_READ, false),
                     (&mut targets.visibility, Access::COPY_READ, false),

@@ -44,14 +44,15 @@ impl Prepass {
     ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "prepass");
+        let shaded = t.shaded.as_mut().expect("the engine's own frames make the shading targets");
         transition(
             ctx,
             cmd,
             &mut [
                 (&mut t.depth, Access::DEPTH_WRITE, true),
                 (&mut t.normal, Access::COLOR_WRITE, true),
-                (&mut t.shading, Access::COLOR_WRITE, true),
-                (&mut t.albedo, Access::COLOR_WRITE, true),
+                (&mut shaded.shading, Access::COLOR_WRITE, true),
+                (&mut shaded.albedo, Access::COLOR_WRITE, true),
             ],
         );
         let pass = RenderPass::begin(
@@ -59,8 +60,8 @@ impl Prepass {
             cmd,
             &[
                 Attachment::clear_color(&t.normal, [0.0; 4]),
-                Attachment::clear_color(&t.shading, [0.0; 4]),
-                Attachment::clear_color(&t.albedo, [0.0; 4]),
+                Attachment::clear_color(&shaded.shading, [0.0; 4]),
+                Attachment::clear_color(&shaded.albedo, [0.0; 4]),
             ],
             Some(Attachment::clear_depth(&t.depth, 0.0)),
         );
@@ -75,8 +76,8 @@ impl Prepass {
             &mut [
                 (&mut t.depth, Access::DEPTH_FRAGMENT_READ, false),
                 (&mut t.normal, Access::FRAGMENT_READ, false),
-                (&mut t.shading, Access::FRAGMENT_READ, false),
-                (&mut t.albedo, Access::FRAGMENT_READ, false),
+                (&mut shaded.shading, Access::FRAGMENT_READ, false),
+                (&mut shaded.albedo, Access::FRAGMENT_READ, false),
             ],
         );
         frame.timer.end(ctx, cmd);
@@ -112,7 +113,8 @@ impl Composite {
     ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "composite");
-        let color = into.unwrap_or(&mut t.color);
+        let shaded = t.shaded.as_mut().expect("the engine's own frames make the shading targets");
+        let color = into.unwrap_or(&mut shaded.color);
         transition(
             ctx,
             cmd,
@@ -126,8 +128,8 @@ impl Composite {
             &[
                 Descriptor::Buffer(globals),
                 Descriptor::Image(&t.depth),
-                Descriptor::Image(&t.shading),
-                Descriptor::Image(&t.albedo),
+                Descriptor::Image(&shaded.shading),
+                Descriptor::Image(&shaded.albedo),
                 Descriptor::Image(&t.visibility),
             ],
         )?;

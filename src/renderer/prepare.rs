@@ -97,11 +97,15 @@ impl FrameData {
         }
 
         let (w, h) = (extent.width as f32, extent.height as f32);
-        let camera = camera.unwrap_or_else(|| {
-            let cam = &scene.camera;
-            let scene_bounds = draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
-            CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, w / h, &scene_bounds)
-        });
+        let camera = match camera {
+            Some(camera) => camera,
+            None => {
+                let cam = &scene.camera;
+                let scene_bounds = draws.iter().fold(Aabb::EMPTY, |b, d| b.union(&d.bounds));
+                CameraProjection::new(cam.position, cam.target, cam.up, cam.projection, w / h, &scene_bounds)
+                    .map_err(|e| crate::error::Error::Invalid(format!("scene camera: {e}")))?
+            }
+        };
         let globals = FrameGlobals {
             view_proj: camera.view_proj,
             inv_view_proj: camera.inv_view_proj,

@@ -111,6 +111,7 @@ impl Embedder {
             queue_index: 0,
             enabled_features: features,
             enabled_core_features: softshadow::required_core_features(),
+            allocation_callbacks: None,
         }
     }
 

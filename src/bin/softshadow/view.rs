@@ -9,8 +9,9 @@ use anyhow::{Context as _, Result};
 use glam::Vec3;
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::{Metrics, TimingReport};
+use softshadow::scene::Scene;
 use softshadow::technique::registry::ground_truth;
-use softshadow::technique::{Kind, Params, Runs, TECHNIQUES};
+use softshadow::technique::{Kind, Params, Runs, TECHNIQUES, TechniqueInfo};
 use softshadow::{AppWindow, Capture, Engine, FrameSettings, FrameTimings, WindowOptions};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::keyboard::{Key, ModifiersState, NamedKey};
@@ -56,6 +57,133 @@ impl Orbit {
     }
 }
 
+/// One input the viewer acts on, decoded from the window's events.
+#[derive(Clone, Debug, PartialEq)]
+enum Input {
+    Close,
+    Modifiers(ModifiersState),
+    /// Left (`true`) or right mouse button, pressed or released.
+    Button {
+        left: bool,
+        down: bool,
+    },
+    Cursor(f64, f64),
+    /// Wheel lines toward the scene.
+    Wheel(f32),
+    Key(Key),
+}
+
+fn decode(event: WindowEvent) -> Option<Input> {
+    Some(match event {
+        WindowEvent::CloseRequested => Input::Close,
+        WindowEvent::ModifiersChanged(m) => Input::Modifiers(m.state()),
+        WindowEvent::MouseInput { state, button, .. } => {
+            let left = match button {
+                MouseButton::Left => true,
+                MouseButton::Right => false,
+                _ => return None,
+            };
+            Input::Button { left, down: state == ElementState::Pressed }
+        }
+        WindowEvent::CursorMoved { position, .. } => Input::Cursor(position.x, position.y),
+        WindowEvent::MouseWheel { delta, .. } => Input::Wheel(match delta {
+            MouseScrollDelta::LineDelta(_, y) => y,
+            MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+        }),
+        WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+            Input::Key(event.logical_key)
+        }
+        _ => return None,
+    })
+}
+
+/// What the inputs of a frame asked for beyond moving the camera, the light and the knobs.
+#[derive(Debug, Default, PartialEq)]
+struct Requests {
+    quit: bool,
+    screenshot: bool,
+    compare: bool,
+}
+
+/// The viewer's state between inputs: the orbit, the cursor, the buttons and modifiers held.
+struct Controls {
+    orbit: Orbit,
+    cursor: Option<(f64, f64)>,
+    /// Left, right.
+    buttons: [bool; 2],
+    modifiers: ModifiersState,
+}
+
+impl Controls {
+    /// Orbiting the scene camera's target from where the camera stands.
+    fn new(scene: &Scene) -> Self {
+        let offset = scene.camera.position - scene.camera.target;
+        let orbit = Orbit {
+            target: scene.camera.target,
+            distance: offset.length(),
+            yaw: offset.x.atan2(offset.z),
+            pitch: (offset.y / offset.length()).asin(),
+        };
+        Controls { orbit, cursor: None, buttons: [false; 2], modifiers: ModifiersState::empty() }
+    }
+
+    /// Left drag orbits, right drag pans, the wheel zooms, Ctrl + left drag moves the light over
+    /// the ground; keys as [`KEYS`] says.
+    fn handle(
+        &mut self,
+        input: Input,
+        scene: &mut Scene,
+        params: &mut Params,
+        techniques: &[&'static TechniqueInfo],
+        asked: &mut Requests,
+    ) {
+        let orbit = &mut self.orbit;
+        match input {
+            Input::Close => asked.quit = true,
+            Input::Modifiers(m) => self.modifiers = m,
+            Input::Button { left, down } => self.buttons[usize::from(!left)] = down,
+            Input::Cursor(x, y) => {
+                if let Some((x0, y0)) = self.cursor {
+                    let (dx, dy) = ((x - x0) as f32, (y - y0) as f32);
+                    let (forward, right) = frame_axes(orbit);
+                    let metres = orbit.distance * 0.002;
+                    if self.buttons[0] && self.modifiers.control_key() {
+                        let ground = |v: Vec3| Vec3::new(v.x, 0.0, v.z).normalize_or_zero();
+                        scene.light.position += (ground(right) * dx - ground(forward) * dy) * metres;
+                    } else if self.buttons[0] {
+                        orbit.yaw -= dx * 0.01;
+                        orbit.pitch = (orbit.pitch + dy * 0.01).clamp(-1.5, 1.5);
+                    } else if self.buttons[1] {
+                        let up = right.cross(forward);
+                        orbit.target += (up * dy - right * dx) * metres;
+                    }
+                }
+                self.cursor = Some((x, y));
+            }
+            Input::Wheel(lines) => orbit.distance = (orbit.distance * 0.9f32.powf(lines)).max(0.01),
+            Input::Key(key) => match key.as_ref() {
+                Key::Named(NamedKey::Escape) => asked.quit = true,
+                Key::Named(NamedKey::Tab) => {
+                    let i = techniques.iter().position(|t| t.name == params.technique.name).map_or(0, |i| i + 1);
+                    *params = Params::defaults(techniques[i % techniques.len()]);
+                }
+                Key::Character("[") => scene.light.radius /= 1.25,
+                Key::Character("]") => scene.light.radius = (scene.light.radius * 1.25).max(0.01),
+                Key::Character("-") => step_first_knob(params, 0.5),
+                Key::Character("+" | "=") => step_first_knob(params, 2.0),
+                Key::Character("s" | "S") => asked.screenshot = true,
+                Key::Character("r" | "R") => asked.compare = true,
+                _ => {}
+            },
+        }
+    }
+
+    fn place_camera(&self, scene: &mut Scene) {
+        scene.camera.position = self.orbit.position();
+        scene.camera.target = self.orbit.target;
+    }
+}
+
 pub fn view(args: &ViewArgs) -> Result<()> {
     let (mut scene, settings) = super::load(&super::SceneArgs {
         scene: args.scene.clone(),
@@ -69,81 +197,23 @@ pub fn view(args: &ViewArgs) -> Result<()> {
     let mut engine = Engine::windowed(&ContextOptions::from_env(), app.window().clone(), WindowOptions::default())?;
     let techniques: Vec<_> = TECHNIQUES.iter().copied().filter(|t| t.kind == Kind::Realtime).collect();
     let mut params = settings.params;
-    let offset = scene.camera.position - scene.camera.target;
-    let mut orbit = Orbit {
-        target: scene.camera.target,
-        distance: offset.length(),
-        yaw: offset.x.atan2(offset.z),
-        pitch: (offset.y / offset.length()).asin(),
-    };
+    let mut controls = Controls::new(&scene);
     if args.frames.is_none() {
         println!("{KEYS}");
     }
-    let (mut cursor, mut buttons, mut modifiers) = (None::<(f64, f64)>, [false; 2], ModifiersState::empty());
     let mut recent: VecDeque<FrameTimings> = VecDeque::new();
     let mut frame = 0u64;
     let mut shots = 0;
     'view: loop {
-        let (mut screenshot, mut compare) = (false, false);
-        for event in app.poll() {
-            match event {
-                WindowEvent::CloseRequested => break 'view,
-                WindowEvent::ModifiersChanged(m) => modifiers = m.state(),
-                WindowEvent::MouseInput { state, button, .. } => {
-                    let down = state == ElementState::Pressed;
-                    match button {
-                        MouseButton::Left => buttons[0] = down,
-                        MouseButton::Right => buttons[1] = down,
-                        _ => {}
-                    }
-                }
-                WindowEvent::CursorMoved { position, .. } => {
-                    if let Some((x, y)) = cursor {
-                        let (dx, dy) = ((position.x - x) as f32, (position.y - y) as f32);
-                        let (forward, right) = frame_axes(&orbit);
-                        let metres = orbit.distance * 0.002;
-                        if buttons[0] && modifiers.control_key() {
-                            let ground = |v: Vec3| Vec3::new(v.x, 0.0, v.z).normalize_or_zero();
-                            scene.light.position += (ground(right) * dx - ground(forward) * dy) * metres;
-                        } else if buttons[0] {
-                            orbit.yaw -= dx * 0.01;
-                            orbit.pitch = (orbit.pitch + dy * 0.01).clamp(-1.5, 1.5);
-                        } else if buttons[1] {
-                            let up = right.cross(forward);
-                            orbit.target += (up * dy - right * dx) * metres;
-                        }
-                    }
-                    cursor = Some((position.x, position.y));
-                }
-                WindowEvent::MouseWheel { delta, .. } => {
-                    let lines = match delta {
-                        MouseScrollDelta::LineDelta(_, y) => y,
-                        MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
-                    };
-                    orbit.distance = (orbit.distance * 0.9f32.powf(lines)).max(0.01);
-                }
-                WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                    match event.logical_key.as_ref() {
-                        Key::Named(NamedKey::Escape) => break 'view,
-                        Key::Named(NamedKey::Tab) => {
-                            let i =
-                                techniques.iter().position(|t| t.name == params.technique.name).map_or(0, |i| i + 1);
-                            params = Params::defaults(techniques[i % techniques.len()]);
-                        }
-                        Key::Character("[") => scene.light.radius /= 1.25,
-                        Key::Character("]") => scene.light.radius = (scene.light.radius * 1.25).max(0.01),
-                        Key::Character("-") => step_first_knob(&mut params, 0.5),
-                        Key::Character("+" | "=") => step_first_knob(&mut params, 2.0),
-                        Key::Character("s" | "S") => screenshot = true,
-                        Key::Character("r" | "R") => compare = true,
-                        _ => {}
-                    }
-                }
-                _ => {}
-            }
+        let mut asked = Requests::default();
+        for input in app.poll().into_iter().filter_map(decode) {
+            controls.handle(input, &mut scene, &mut params, &techniques, &mut asked);
         }
-        scene.camera.position = orbit.position();
-        scene.camera.target = orbit.target;
+        if asked.quit {
+            break 'view;
+        }
+        let (screenshot, compare) = (asked.screenshot, asked.compare);
+        controls.place_camera(&mut scene);
 
         frame += 1;
         let last = args.frames.is_some_and(|n| frame >= n);
@@ -222,7 +292,7 @@ fn save_screenshot(capture: &Capture, report: &TimingReport, stem: &str) -> Resu
 
 /// Renders the technique and the GPU reference for the current view offscreen, and prints the
 /// technique's error.
-fn compare_with_reference(engine: &mut Engine, scene: &softshadow::scene::Scene, params: &Params) -> Result<()> {
+fn compare_with_reference(engine: &mut Engine, scene: &Scene, params: &Params) -> Result<()> {
     let stats = engine.window_stats().context("a windowed engine")?;
     let (width, height) = (stats.width, stats.height);
     let ours = engine.render_and_capture(scene, &FrameSettings { width, height, params: params.clone() })?;
@@ -234,4 +304,154 @@ fn compare_with_reference(engine: &mut Engine, scene: &softshadow::scene::Scene,
         params.technique.name, m.rmse, m.penumbra_rmse, m.max_abs
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use softshadow::technique::find;
+
+    fn setup() -> (Controls, Scene, Params, Vec<&'static TechniqueInfo>) {
+        let scene = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/default.toml")).unwrap();
+        let techniques = TECHNIQUES.iter().copied().filter(|t| t.kind == Kind::Realtime).collect();
+        (Controls::new(&scene), scene, Params::defaults(find("pcss").unwrap()), techniques)
+    }
+
+    /// Feeds `inputs`, places the camera, returns what they asked for.
+    fn feed(
+        c: &mut Controls,
+        scene: &mut Scene,
+        params: &mut Params,
+        t: &[&'static TechniqueInfo],
+        inputs: &[Input],
+    ) -> Requests {
+        let mut asked = Requests::default();
+        for input in inputs {
+            c.handle(input.clone(), scene, params, t, &mut asked);
+        }
+        c.place_camera(scene);
+        asked
+    }
+
+    fn drag(left: bool, from: (f64, f64), to: (f64, f64)) -> Vec<Input> {
+        vec![
+            Input::Cursor(from.0, from.1),
+            Input::Button { left, down: true },
+            Input::Cursor(to.0, to.1),
+            Input::Button { left, down: false },
+        ]
+    }
+
+    #[test]
+    fn the_controls_start_at_the_scenes_camera() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let before = scene.camera.clone();
+        feed(&mut c, &mut scene, &mut params, &t, &[]);
+        assert!(
+            (scene.camera.position - before.position).length() < 1e-4,
+            "{} {}",
+            scene.camera.position,
+            before.position
+        );
+        assert_eq!(scene.camera.target, before.target);
+    }
+
+    /// Left drag orbits: the camera moves around the target at the same distance, the light
+    /// stays; moving the cursor with no button held does nothing.
+    #[test]
+    fn left_drag_orbits_around_the_target() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let (start, light) = (scene.camera.position, scene.light.position);
+        feed(&mut c, &mut scene, &mut params, &t, &[Input::Cursor(10.0, 10.0), Input::Cursor(300.0, 40.0)]);
+        assert!((scene.camera.position - start).length() < 1e-4, "moved without a button");
+        feed(&mut c, &mut scene, &mut params, &t, &drag(true, (10.0, 10.0), (110.0, 10.0)));
+        let (d0, d1) = ((start - scene.camera.target).length(), (scene.camera.position - scene.camera.target).length());
+        assert!((scene.camera.position - start).length() > 0.1, "the camera did not orbit");
+        assert!((d0 - d1).abs() < 1e-3 * d0, "distance {d0} became {d1}");
+        assert!((scene.camera.position.y - start.y).abs() < 1e-3, "a horizontal drag changed the height");
+        assert_eq!(scene.light.position, light);
+    }
+
+    /// Right drag pans: target and camera move by the same vector, across the view.
+    #[test]
+    fn right_drag_pans_the_view() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let (position, target) = (scene.camera.position, scene.camera.target);
+        feed(&mut c, &mut scene, &mut params, &t, &drag(false, (50.0, 50.0), (0.0, 50.0)));
+        let moved = scene.camera.target - target;
+        assert!(moved.length() > 0.01, "the target did not move");
+        assert!((scene.camera.position - position - moved).length() < 1e-4, "camera and target moved apart");
+        assert!(
+            moved.dot(target - position).abs() < 1e-4 * moved.length() * (target - position).length(),
+            "not across"
+        );
+    }
+
+    /// The wheel zooms: toward the target by 0.9 per line, the direction kept.
+    #[test]
+    fn the_wheel_zooms_toward_the_target() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let before = scene.camera.position - scene.camera.target;
+        feed(&mut c, &mut scene, &mut params, &t, &[Input::Wheel(2.0)]);
+        let after = scene.camera.position - scene.camera.target;
+        assert!((after.length() / before.length() - 0.81).abs() < 1e-4, "{} → {}", before.length(), after.length());
+        assert!(after.normalize().dot(before.normalize()) > 0.9999);
+    }
+
+    /// Ctrl + left drag moves the light over the ground (its height kept), not the camera.
+    #[test]
+    fn ctrl_drag_moves_the_light_over_the_ground() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let (light, camera) = (scene.light.position, scene.camera.position);
+        let mut inputs = vec![Input::Modifiers(ModifiersState::CONTROL)];
+        inputs.extend(drag(true, (0.0, 0.0), (80.0, -40.0)));
+        feed(&mut c, &mut scene, &mut params, &t, &inputs);
+        assert!((scene.light.position - light).length() > 0.05, "the light did not move");
+        assert_eq!(scene.light.position.y, light.y);
+        assert!((scene.camera.position - camera).length() < 1e-4, "the camera moved");
+    }
+
+    /// Tab cycles the real-time techniques (and wraps); [ ] change the light's radius; - +
+    /// halve and double the first knob within its range; S, R and Esc ask for a screenshot, the
+    /// reference comparison and quitting.
+    #[test]
+    fn keys_switch_techniques_and_knobs_and_ask_for_shots() {
+        let (mut c, mut scene, mut params, t) = setup();
+        let key = |k: &str| Input::Key(Key::Character(k.into()));
+        let at = t.iter().position(|x| x.name == "pcss").unwrap();
+        feed(&mut c, &mut scene, &mut params, &t, &[Input::Key(Key::Named(NamedKey::Tab))]);
+        assert_eq!(params.technique.name, t[(at + 1) % t.len()].name);
+        let tabs = vec![Input::Key(Key::Named(NamedKey::Tab)); t.len()];
+        feed(&mut c, &mut scene, &mut params, &t, &tabs);
+        assert_eq!(params.technique.name, t[(at + 1) % t.len()].name, "a full cycle comes back");
+
+        let radius = scene.light.radius;
+        feed(&mut c, &mut scene, &mut params, &t, &[key("]")]);
+        assert!((scene.light.radius - radius * 1.25).abs() < 1e-6);
+        feed(&mut c, &mut scene, &mut params, &t, &[key("["), key("[")]);
+        assert!((scene.light.radius - radius / 1.25).abs() < 1e-6);
+
+        params = Params::defaults(find("pcss").unwrap());
+        let info = params.technique;
+        let knob = &info.knobs[0];
+        let halved = (params.get(knob) * 0.5).clamp(knob.min, knob.max);
+        feed(&mut c, &mut scene, &mut params, &t, &[key("-")]);
+        assert_eq!(params.get(knob), if knob.integer { halved.round() } else { halved });
+        for _ in 0..64 {
+            feed(&mut c, &mut scene, &mut params, &t, &[key("+")]);
+        }
+        assert_eq!(params.get(knob), knob.max, "doubling stops at the knob's maximum");
+
+        assert_eq!(
+            feed(&mut c, &mut scene, &mut params, &t, &[key("s")]),
+            Requests { screenshot: true, ..Default::default() }
+        );
+        assert_eq!(
+            feed(&mut c, &mut scene, &mut params, &t, &[key("R")]),
+            Requests { compare: true, ..Default::default() }
+        );
+        let quit = feed(&mut c, &mut scene, &mut params, &t, &[Input::Key(Key::Named(NamedKey::Escape))]);
+        assert!(quit.quit);
+        assert!(feed(&mut c, &mut scene, &mut params, &t, &[Input::Close]).quit);
+    }
 }
