@@ -38,11 +38,11 @@ fn posts(k: usize) -> Result<Scene, Box<dyn std::error::Error>> {
 
 /// Screens of volume fill from the light's centre: the sides (z-pass) and the sides and caps
 /// (z-fail).
-fn fill(scene: &Scene, aspect: f32) -> (f64, f64) {
+fn fill(scene: &Scene, aspect: f32) -> Result<(f64, f64), String> {
     let bounds =
         scene.objects.iter().fold(Aabb::EMPTY, |b, o| b.union(&o.mesh.bounds.transformed(&o.transform.matrix())));
     let c = &scene.camera;
-    let camera = CameraProjection::new(c.position, c.target, c.up, c.projection, aspect, &bounds);
+    let camera = CameraProjection::new(c.position, c.target, c.up, c.projection, aspect, &bounds)?;
     let light = scene.light.position;
     let (mut sides, mut all) = (0.0, 0.0);
     for o in scene.objects.iter().filter(|o| o.casts) {
@@ -53,7 +53,7 @@ fn fill(scene: &Scene, aspect: f32) -> (f64, f64) {
         sides += screen_fill(&volume, &positions, light, camera.view_proj, false);
         all += screen_fill(&volume, &positions, light, camera.view_proj, true);
     }
-    (sides, all)
+    Ok((sides, all))
 }
 
 /// What is measured at each K: the technique, its knobs, and whether its fill passes are shown.
@@ -117,7 +117,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for k in [1, 2, 4, 8, 16, 32] {
         let scene = posts(k)?;
-        let (fill_pass, fill_fail) = fill(&scene, 1.0);
+        let (fill_pass, fill_fail) = fill(&scene, 1.0)?;
         let ms = measure(&mut engines, &scene, size, frames)?;
         let map = ms[0].0;
         let mut row = format!("| {k} | {fill_pass:.2} | {fill_fail:.2} | {map:.2} |");
