@@ -3,7 +3,8 @@
 // falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
 // Outer only (the paper), t is 0 under the hard shadow mask. Centred (issue 20), t is the
 // distance to the hard edge in half widths, signed by the mask (negative inside), and the curve
-// spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge.
+// spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge; times, over a hard shadow,
+// what other casters' outer penumbrae there let through (channel g, see penumbra.frag).
 #include "interface.glsl"
 #include "camera.glsl"
 #include "falloff.glsl"
@@ -25,22 +26,23 @@ layout(set = 0, binding = 6) uniform sampler2D falloff;
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// One texel's curve parameter: t outside the mask; inside, 0 (outer only) or −t (centred).
-float texel_s(ivec2 i) {
-    float t = texelFetch(plateau_texture, i, 0).r;
+// One texel's curve parameters: t outside the mask; inside, 0 (outer only) or −t (centred);
+// and the other casters' outer t.
+vec2 texel_s(ivec2 i) {
+    vec2 t = texelFetch(plateau_texture, i, 0).rg;
     bool shadowed = texelFetch(umbra_mask, i, 0).r > 0.0;
-    return shadowed ? (CENTRED ? -t : 0.0) : t;
+    return vec2(shadowed ? (CENTRED ? -t.r : 0.0) : t.r, t.g);
 }
 
-// Bilinear s from the texels (the sampler is nearest): the gradient stays smooth, and where t
-// is 0 on the hard edge the sign flips without a step.
-float plateau_s(vec2 tc) {
+// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
+// 0 on the hard edge the sign flips without a step.
+vec2 plateau_s(vec2 tc) {
     vec2 size = vec2(textureSize(plateau_texture, 0));
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     ivec2 i = ivec2(floor(pos));
     vec2 f = fract(pos);
-    float a = mix(texel_s(i), texel_s(i + ivec2(1, 0)), f.x);
-    float b = mix(texel_s(i + ivec2(0, 1)), texel_s(i + ivec2(1, 1)), f.x);
+    vec2 a = mix(texel_s(i), texel_s(i + ivec2(1, 0)), f.x);
+    vec2 b = mix(texel_s(i + ivec2(0, 1)), texel_s(i + ivec2(1, 1)), f.x);
     return mix(a, b, f.y);
 }
 
@@ -74,6 +76,8 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    float signed_t = plateau_s(tc);
-    out_visibility = falloff_at(falloff, FALLOFF, CENTRED ? 0.5 + 0.5 * signed_t : signed_t);
+    vec2 signed_t = plateau_s(tc);
+    out_visibility = CENTRED
+        ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.x) * falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.y)
+        : falloff_at(falloff, FALLOFF, signed_t.x);
 }

@@ -56,8 +56,9 @@ use crate::geometry::plateau::{
 };
 use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox};
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame, Pipeline,
-    PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_vertices, ensure, shaders, transition,
+    Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_vertices, ensure, shaders,
+    transition,
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -135,7 +136,9 @@ const OFF_PLANE: Knob = Knob {
     help: "receivers off the plane: 0 unshadowed, 1 the projected light map",
 };
 
-const PLATEAU_FORMAT: vk::Format = vk::Format::R16_UNORM;
+/// The plateau texture: t of the caster whose hard shadow covers the texel (or of every caster,
+/// where none does), and centred, t of other casters' outer penumbrae over that hard shadow.
+const PLATEAU_FORMAT: vk::Format = vk::Format::R16G16_UNORM;
 /// The umbra mask: each texel the number of the caster whose hard shadow covers it (0: none).
 const MASK_FORMAT: vk::Format = vk::Format::R16_UNORM;
 
@@ -345,7 +348,7 @@ impl Technique for Plateau {
             let desc = PipelineDesc::new("penumbra", &shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG)
                 .vertex_input(VertexInput::Floats(&PLATEAU_VERTEX_FLOATS))
                 .colors(&[PLATEAU_FORMAT])
-                .depth(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::LESS))
+                .blend(Blend::Min)
                 .constants(&constants);
             Pipeline::new(ctx, &desc)
         })?;
@@ -353,23 +356,15 @@ impl Technique for Plateau {
         let ranges = [("cones", 0, cones), ("sheets", cones, geometry.sheets.len() as u32)];
         for (i, (name, first, count)) in ranges.into_iter().enumerate() {
             frame.timer.begin(ctx, cmd, name);
-            // The sides read the mask; the cones' pass clears t to 1 (lit) and far, the sheets'
-            // carries on.
+            // The sides read the mask; the cones' pass clears t to 1 (lit), the sheets' carries
+            // on. Blended by min, channel by channel: the darkest primitive wins (§2).
             let fresh = i == 0;
-            transition(
-                ctx,
-                cmd,
-                &mut [
-                    (mask, Access::FRAGMENT_READ, false),
-                    (texture, Access::COLOR_WRITE, fresh),
-                    (depth, Access::DEPTH_WRITE, fresh),
-                ],
-            );
-            let (color, far) = match fresh {
-                true => (Attachment::clear_color(texture, [1.0; 4]), Attachment::clear_depth(depth, 1.0)),
-                false => (Attachment { target: texture, clear: None }, Attachment { target: depth, clear: None }),
+            transition(ctx, cmd, &mut [(mask, Access::FRAGMENT_READ, false), (texture, Access::COLOR_WRITE, fresh)]);
+            let color = match fresh {
+                true => Attachment::clear_color(texture, [1.0; 4]),
+                false => Attachment { target: texture, clear: None },
             };
-            let pass = RenderPass::begin(ctx, cmd, &[color], Some(far));
+            let pass = RenderPass::begin(ctx, cmd, &[color], None);
             if let Some(v) = &self.vertices {
                 penumbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Image(mask)])?;
                 draw_vertices(ctx, cmd, v.range(frame.slot), first, count);
