@@ -96,18 +96,21 @@ impl ReceiverPlane {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PenumbraSize {
     /// From the light sphere: the footprint on the plane of the cone of rays from the vertex to
-    /// the light (width W = D·h/(H − h) under a light overhead), times `scale` (the outer-only
-    /// plateau starts where the true penumbra is half way, see `PLATEAU_SCALE`).
+    /// the light (width W = D·h/(H − h) under a light overhead): cone radius `scale` × W/2, the
+    /// true half width on each side of the hard edge at 1.
     Physical { scale: f32 },
     /// Haines §3: radius = factor × height (0.1 in most of the paper's images).
     Haines { factor: f32 },
 }
 
-/// The base of a vertex cone: an ellipse about the projected vertex (its apex),
-/// { centre + axes·x : |x| ≤ 1 }.
+/// A vertex cone: its apex, the projected vertex `centre`, over an elliptical base
+/// { centre + offset + axes·x : |x| ≤ 1 }.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cone {
     pub centre: Vec2,
+    /// From the apex to the base's centre: away from a low light, whose footprint reaches
+    /// further beyond the projected vertex than short of it.
+    pub offset: Vec2,
     /// Columns: the semi-major axis (pointing away from the light) and the semi-minor axis.
     pub axes: Mat2,
 }
@@ -115,14 +118,15 @@ pub struct Cone {
 impl Cone {
     /// The support function: max over the base of ν·x.
     fn support(&self, nu: Vec2) -> f32 {
-        nu.dot(self.centre) + (self.axes.transpose() * nu).length()
+        nu.dot(self.centre + self.offset) + (self.axes.transpose() * nu).length()
     }
 
     /// The point of the base where the tangent with outward normal ν touches it.
     fn support_point(&self, nu: Vec2) -> Vec2 {
         let a = self.axes.transpose() * nu;
         let len = a.length();
-        if len == 0.0 { self.centre } else { self.centre + self.axes * (a / len) }
+        let base = self.centre + self.offset;
+        if len == 0.0 { base } else { base + self.axes * (a / len) }
     }
 
     pub fn is_point(&self) -> bool {
@@ -137,14 +141,17 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
     let centre = plane.project(light, p)?;
     let h = plane.height(p);
     if h <= 0.0 || radius == 0.0 && matches!(size, PenumbraSize::Physical { .. }) {
-        return Some(Cone { centre, axes: Mat2::ZERO });
+        return Some(Cone { centre, offset: Vec2::ZERO, axes: Mat2::ZERO });
     }
     match size {
-        PenumbraSize::Haines { factor } => Some(Cone { centre, axes: Mat2::from_diagonal(Vec2::splat(factor * h)) }),
+        PenumbraSize::Haines { factor } => {
+            Some(Cone { centre, offset: Vec2::ZERO, axes: Mat2::from_diagonal(Vec2::splat(factor * h)) })
+        }
         PenumbraSize::Physical { scale } => {
             // The rays from p towards the light sphere form a cone of half-angle α about the
             // axis from the light through p, tilted θ from the plane's normal. Across the tilt
-            // its section spans h·tan(θ ± α); sideways about h·tan α / cos θ (§3's ellipse,
+            // its section spans h·tan(θ ± α) from p's foot, so its middle lies beyond the
+            // projected vertex (at h·tan θ); sideways about h·tan α / cos θ (§3's ellipse,
             // major axis away from the light).
             let axis = (p - plane.origin - (light - plane.origin)).normalize();
             let away = Vec2::new(axis.dot(plane.u), axis.dot(plane.v));
@@ -157,8 +164,13 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
             let tan = |x: f32| x.min(cap).tan();
             let semi_major = 0.5 * h * (tan(theta + alpha) - tan(theta - alpha));
             let semi_minor = h * tan(alpha) / theta.cos();
+            let beyond = 0.5 * h * (tan(theta + alpha) + tan(theta - alpha)) - h * theta.tan();
             let minor = major.perp();
-            Some(Cone { centre, axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale) })
+            Some(Cone {
+                centre,
+                offset: major * beyond * scale,
+                axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale),
+            })
         }
     }
 }
@@ -252,7 +264,7 @@ impl PlateauGeometry {
         }
         let rim = |k: u32| {
             let a = std::f32::consts::TAU * k as f32 / segments as f32;
-            cone.centre + cone.axes * Vec2::new(a.cos(), a.sin())
+            cone.centre + cone.offset + cone.axes * Vec2::new(a.cos(), a.sin())
         };
         let foot = Foot { at: cone.centre, normal: Vec2::ZERO, caster };
         for k in 0..segments {
@@ -369,7 +381,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn circle(x: f32, y: f32, r: f32) -> Cone {
-        Cone { centre: Vec2::new(x, y), axes: Mat2::from_diagonal(Vec2::splat(r)) }
+        Cone { centre: Vec2::new(x, y), offset: Vec2::ZERO, axes: Mat2::from_diagonal(Vec2::splat(r)) }
     }
 
     /// Two cone radii in `min..2`: equal in a third of the cases (a plate parallel to the plane,
@@ -524,11 +536,13 @@ mod tests {
             plateau_sides(&plane, &light, &caster, 3.0, EdgeSource::Silhouettes, &mut Mailbox::default(), 1)
         };
         let (outer, centred) = (sides(Penumbra::Outer), sides(Penumbra::Centred));
-        assert_eq!(centred.sheets.len(), 2 * outer.sheets.len());
+        // A sheet more per edge (each tessellated by its own twist).
+        assert!(centred.sheets.len() > outer.sheets.len());
+        assert!(outer.sheets.iter().all(|v| centred.sheets.contains(v)));
         assert_eq!(centred.cones, outer.cones);
-        // The top face (y = 1.05) casts the square |x|, |z| ≤ 1.05·9/7.95; the radius is W/2
+        // The top face (y = 1.05) casts the square |x|, |z| ≤ 9/7.95; the radius is W/2
         // overhead, a few per cent more towards the corners (their cones lean out).
-        let half = 1.05 * 9.0 / 7.95;
+        let half = 9.0 / 7.95;
         let r = 0.5 * 1.05 / 7.95;
         let (mut inside, mut outside) = (0, 0);
         for v in &centred.sheets {
@@ -568,6 +582,10 @@ mod tests {
             assert!(major.length() >= minor.length() && major.length() > first, "{elevation}°");
             assert!(major.length() <= MAX_TILT_TAN * p.y, "{elevation}°: capped");
             assert!(major.x.abs() > 0.99 * major.length(), "the major axis points along the light's azimuth");
+            // The footprint reaches further beyond the projected vertex than short of it.
+            let away = major.normalize();
+            let (beyond, short) = (cone.support(away) - away.dot(cone.centre), cone.support(-away) + away.dot(cone.centre));
+            assert!(beyond > short && short > 0.0, "{elevation}°: {beyond} beyond, {short} short");
         }
         // Touching the plane: a point; at or above the light: nothing.
         assert!(vertex_cone(&plane, Vec3::Y * 5.0, 0.5, size, Vec3::ZERO).unwrap().is_point());

@@ -188,7 +188,10 @@ impl Plateau {
         let umbra = PipelineDesc::new("umbra", &shaders::PLATEAU_UMBRA_VERT, &shaders::PLATEAU_UMBRA_FRAG)
             .vertex_input(MESH_POSITIONS)
             .colors(&[MASK_FORMAT])
-            .depth(depth);
+            .depth(depth)
+            // The depth orders casters, it must not clip them: only w > 0 may cut a caster
+            // reaching above the light, whose umbra runs to the horizon.
+            .depth_clamp();
         let umbra = Guard::new(ctx, Pipeline::new(ctx, &umbra)?);
         let size = std::mem::size_of::<PlateauView>() as u64;
         let view = PerFrame::new(ctx, "plateau view", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?;
