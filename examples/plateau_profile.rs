@@ -49,14 +49,18 @@ fn truth(e: &mut Engine, s: &Scene, size: u32) -> softshadow::Result<Capture> {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/docs").into()));
+    let out =
+        PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| concat!(env!("CARGO_MANIFEST_DIR"), "/docs").into()));
     let mut e = Engine::headless(&ContextOptions { validation: false, device: None })?;
 
     let plate = Scene::from_toml(PLATE_EDGE, "examples/plate_edge.toml")?;
     let forms: [(&str, &[(&str, &str)]); 3] = [
         ("plateau, centred (default)", &[]),
         ("plateau, outer only (physical size)", &[("penumbra", "0"), ("falloff", "0")]),
-        ("plateau, outer only (scale 0.4, the old default)", &[("penumbra", "0"), ("falloff", "0"), ("penumbra_scale", "0.4")]),
+        (
+            "plateau, outer only (scale 0.4, the old default)",
+            &[("penumbra", "0"), ("falloff", "0"), ("penumbra_scale", "0.4")],
+        ),
     ];
     let x = |px: u32| 0.8 + (px as f64 + 0.5) * 0.8 / SIZE as f64 - 1.2;
     let profile = |c: &Capture| -> Vec<(f64, f64)> {

@@ -584,7 +584,8 @@ mod tests {
             assert!(major.x.abs() > 0.99 * major.length(), "the major axis points along the light's azimuth");
             // The footprint reaches further beyond the projected vertex than short of it.
             let away = major.normalize();
-            let (beyond, short) = (cone.support(away) - away.dot(cone.centre), cone.support(-away) + away.dot(cone.centre));
+            let (beyond, short) =
+                (cone.support(away) - away.dot(cone.centre), cone.support(-away) + away.dot(cone.centre));
             assert!(beyond > short && short > 0.0, "{elevation}°: {beyond} beyond, {short} short");
         }
         // Touching the plane: a point; at or above the light: nothing.

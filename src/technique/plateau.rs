@@ -82,7 +82,9 @@ pub const OUTER_ONLY: Setting = &[("penumbra", "0"), ("falloff", "0")];
 /// width: wider only darkens more of the outer half).
 pub const OUTER_ONLY_NARROW: Setting = &[("penumbra", "0"), ("falloff", "0"), ("penumbra_scale", "0.4")];
 
-/// Centred by default: it measured better over the suite (see the README's bench figures).
+/// Centred by default: over the suite (bench, 10 scenes, 512², lavapipe, against the reference)
+/// its median penumbra RMSE is 0.084, against 0.317 for the outer-only form at the physical size
+/// and 0.250 at its old narrow default (PCSS 16+16: 0.076, the hard map: 0.273).
 const CENTRED: Knob = Knob { default: 1.0, ..PENUMBRA };
 /// The disk edge by default: the exact straight-edge profile, which a centred penumbra follows.
 const CURVE: Knob = Knob { default: 3.0, ..FALLOFF };
