@@ -7,7 +7,7 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
-use softshadow::geometry::plateau::{PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
+use softshadow::geometry::plateau::{Penumbra, PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
 use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
 use softshadow::scene::Mesh;
 
@@ -20,7 +20,8 @@ fn plateau(c: &mut Criterion) {
     let light = PlateauLight {
         position: Vec3::new(3.0, 9.0, 2.5),
         radius: 0.4,
-        size: PenumbraSize::Physical { scale: 0.4 },
+        size: PenumbraSize::Physical { scale: 1.0 },
+        penumbra: Penumbra::Centred,
         cone_segments: 32,
     };
     c.bench_function("plateau silhouettes, wingnut", |b| {
@@ -34,7 +35,7 @@ fn plateau(c: &mut Criterion) {
     c.bench_function("plateau sides (silhouettes, cones, sheets), wingnut", |b| {
         b.iter(|| {
             frame += 1;
-            plateau_sides(&plane, &light, black_box(&caster), EdgeSource::Silhouettes, &mut mailbox, frame)
+            plateau_sides(&plane, &light, black_box(&caster), 1.0, EdgeSource::Silhouettes, &mut mailbox, frame)
         })
     });
 }

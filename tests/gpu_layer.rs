@@ -293,8 +293,8 @@ fn a_stencil_pipeline_counts_overlapping_quads() {
         reference: 0,
     };
     let formats = [vk::Format::R16_UNORM];
-    // Any fragment shader with no inputs: the plateau's umbra writes a constant.
-    let desc = PipelineDesc::new("count", &shaders::COMMON_FULLSCREEN_VERT, &shaders::PLATEAU_UMBRA_FRAG)
+    // Any fragment shader with no inputs: the shadow volumes' stencil-only one.
+    let desc = PipelineDesc::new("count", &shaders::COMMON_FULLSCREEN_VERT, &shaders::SHADOW_VOLUME_STENCIL_FRAG)
         .colors(&formats)
         .color_write(vk::ColorComponentFlags::empty())
         .depth(DepthState::test_only(format, vk::CompareOp::ALWAYS))

@@ -58,9 +58,15 @@ fn a_point_light_gives_the_hard_shadow_and_a_huge_light_stays_sane() {
     let m = Metrics::between(&plateau, &hard).unwrap();
     // Two rasterisations of the same edge (projected polygon vs shadow map) differ by a pixel.
     assert!(m.rmse < 0.1, "{m:?}");
-    // A light wider than the wall (radius 2 m): the plateau keeps its umbra and stays finite.
+    // A light wider than the wall (radius 2 m): near the wall V follows the truth's, and the
+    // light's side stays lit. (Further out, 1.8 m behind, the cones' 85° cap keeps an umbra
+    // where the reference has V = 0.28.)
     let huge = render_with(&mut e, &wall(1.0, 2.0), "plateau", &[], SIZE);
-    assert_eq!(huge.visibility_at(column(-1.0), SIZE / 2), 0.0);
+    let truth = common::reference(&mut e, &wall(1.0, 2.0), SIZE);
+    for x in [-0.3, -1.0] {
+        let (v, t) = (huge.visibility_at(column(x), SIZE / 2), truth.visibility_at(column(x), SIZE / 2));
+        assert!((v - t).abs() < 0.15, "{x} m behind the wall: V {v}, the reference's {t}");
+    }
     assert!(huge.visibility_at(column(0.3), SIZE / 8) > 0.99);
     finish(e);
 }
@@ -97,8 +103,9 @@ fn low_lights_stretch_the_shadow_without_breaking() {
     let mut e = engine();
     for elevation in [30.0, 5.0, 1.0] {
         let c = render_with(&mut e, &low_light(elevation), "plateau", &[], 64);
-        // The shadow falls away from the light (−x): dark somewhere there, lit on the light's side.
-        let dark = (0..32).any(|x| c.visibility_at(x, 32) < 0.05);
+        // The shadow falls away from the light (−x): dark somewhere there (x < −1 m, past the
+        // box, where the umbra of the centred penumbra ends), lit on the light's side.
+        let dark = (0..48).any(|x| c.visibility_at(x, 32) < 0.05);
         assert!(dark, "{elevation}°: no shadow behind the box");
         assert!(c.visibility_at(60, 32) > 0.99, "{elevation}°: the light's side must be lit");
     }
@@ -177,10 +184,9 @@ fn nested_and_equal_cone_radii_stay_sane() {
 }
 
 /// RMSE bounds against the reference (N = 256), about 1.45 times what lavapipe measured at 64²
-/// (plate 0.0404, sphere 0.0384; the hard shadow map: 0.0451, 0.0427):
-/// the plateau's umbra is the full hard shadow (Haines §4), so it can only beat the hard shadow
-/// map by a little.
-const BOUNDS: [(&str, f64); 2] = [("plate", 0.06), ("sphere", 0.055)];
+/// with the centred default (plate 0.0053, sphere 0.0186; the hard shadow map: 0.0454, 0.0427;
+/// the outer-only form at its old narrow size: 0.0404, 0.0384).
+const BOUNDS: [(&str, f64); 2] = [("plate", 0.008), ("sphere", 0.027)];
 
 #[test]
 fn the_error_against_the_reference_stays_under_its_bounds() {

@@ -1,7 +1,63 @@
 #version 460
+// The plateau's sides write t, blended by min (the darkest wins, Haines §2), into channel r; g
+// stays 1. Centred (issue 20), t is the distance to the hard shadow's boundary in half widths on
+// both of its sides, so only silhouettes on that boundary may write it: the mask must be lit a
+// couple of texels off the foot, across the edge (either way: an edge seen edge-on has no
+// reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
+// has shadow on both sides and writes nothing, so no bright streak crosses the umbra.
+//
+// Overlapping casters. Channel r holds, over a caster's hard shadow, that caster's bands only
+// (the mask holds the lowest caster where hard shadows overlap), so one caster's inner penumbra
+// never lightens what another blocks. Another caster's outer penumbra over that hard shadow goes
+// to channel g instead, if its edge bounds that caster's own shadow: each blocks part of the
+// light, and the resolve multiplies the two (Chan & Durand Fig. 10's overlapping penumbrae).
+layout(constant_id = 0) const bool CENTRED = false;
+
+layout(set = 0, binding = 1) uniform sampler2D mask;
+
 layout(location = 0) in float in_t;
-layout(location = 0) out float out_t;
+layout(location = 1) in vec2 in_uv;
+layout(location = 2) in vec2 in_foot;
+layout(location = 3) flat in vec2 in_normal;
+layout(location = 4) flat in uint in_caster;
+layout(location = 0) out vec2 out_t;
+
+// How far off the foot the mask is probed, in texels: past the hard edge's rasterisation.
+const float PROBE = 2.0;
+
+uint caster_at(vec2 texel) {
+    ivec2 size = textureSize(mask, 0);
+    ivec2 i = clamp(ivec2(floor(texel)), ivec2(0), size - 1);
+    return uint(round(texelFetch(mask, i, 0).r * 65535.0));
+}
 
 void main() {
-    out_t = in_t;
+    out_t = vec2(in_t, 1.0);
+    if (!CENTRED) {
+        return;
+    }
+    vec2 size = vec2(textureSize(mask, 0));
+    vec2 foot = in_foot * size;
+    vec2 from_foot = in_uv * size - foot;
+    // A cone's normal at this pixel is the direction from its apex.
+    vec2 across = in_normal != vec2(0.0) ? in_normal * size : from_foot;
+    if (dot(across, across) < 1e-8) {
+        discard; // on the apex itself: the sheets meeting there write it
+    }
+    vec2 probe = PROBE * normalize(across);
+    uint here = caster_at(gl_FragCoord.xy);
+    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
+    if (here == 0u || here == in_caster) {
+        if (a != 0u && b != 0u) {
+            discard;
+        }
+        return;
+    }
+    // Over another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
+    // something other than its own caster across it.
+    bool outer_half = in_normal != vec2(0.0) && dot(from_foot, in_normal * size) > 0.0;
+    if (!outer_half || (a == in_caster && b == in_caster)) {
+        discard;
+    }
+    out_t = vec2(1.0, in_t);
 }

@@ -1,6 +1,10 @@
 #version 460
 // Plateau resolve: receivers on the plane read the plateau texture where they stand; V is the
 // falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
+// Outer only (the paper), t is 0 under the hard shadow mask. Centred (issue 20), t is the
+// distance to the hard edge in half widths, signed by the mask (negative inside), and the curve
+// spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge; times, over a hard shadow,
+// what other casters' outer penumbrae there let through (channel g, see penumbra.frag).
 #include "interface.glsl"
 #include "camera.glsl"
 #include "falloff.glsl"
@@ -8,25 +12,37 @@
 // The `off_plane` knob: receivers off the plane read the projected light map (§2), or are
 // unshadowed.
 layout(constant_id = 0) const bool OFF_PLANE_MAP = false;
+// The `penumbra` knob: centred on the hard edge, or outer only.
+layout(constant_id = 1) const bool CENTRED = false;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
 layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D plateau_texture;
-layout(set = 0, binding = 5) uniform sampler2D falloff;
+layout(set = 0, binding = 5) uniform sampler2D umbra_mask;
+layout(set = 0, binding = 6) uniform sampler2D falloff;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// Bilinear t from the plateau texture (the sampler is nearest): the gradient stays smooth.
-float plateau_t(vec2 tc) {
+// One texel's curve parameters: t outside the mask; inside, 0 (outer only) or −t (centred);
+// and the other casters' outer t.
+vec2 texel_s(ivec2 i) {
+    vec2 t = texelFetch(plateau_texture, i, 0).rg;
+    bool shadowed = texelFetch(umbra_mask, i, 0).r > 0.0;
+    return vec2(shadowed ? (CENTRED ? -t.r : 0.0) : t.r, t.g);
+}
+
+// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
+// 0 on the hard edge the sign flips without a step.
+vec2 plateau_s(vec2 tc) {
     vec2 size = vec2(textureSize(plateau_texture, 0));
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     ivec2 i = ivec2(floor(pos));
     vec2 f = fract(pos);
-    float a = mix(texelFetch(plateau_texture, i, 0).r, texelFetch(plateau_texture, i + ivec2(1, 0), 0).r, f.x);
-    float b = mix(texelFetch(plateau_texture, i + ivec2(0, 1), 0).r, texelFetch(plateau_texture, i + ivec2(1, 1), 0).r, f.x);
+    vec2 a = mix(texel_s(i), texel_s(i + ivec2(1, 0)), f.x);
+    vec2 b = mix(texel_s(i + ivec2(0, 1)), texel_s(i + ivec2(1, 1)), f.x);
     return mix(a, b, f.y);
 }
 
@@ -60,5 +76,8 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    out_visibility = falloff_at(falloff, FALLOFF, plateau_t(tc));
+    vec2 signed_t = plateau_s(tc);
+    out_visibility = CENTRED
+        ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.x) * falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.y)
+        : falloff_at(falloff, FALLOFF, signed_t.x);
 }

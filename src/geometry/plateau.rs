@@ -6,6 +6,13 @@
 //! Everything lives in the receiver plane's coordinates (u, v) plus the plateau parameter
 //! t ∈ [0, 1]: 0 on the hard shadow edge (the hither, darkest), 1 on the penumbra's outer rim
 //! (the yon, lit). Drawn with depth = t, the darkest primitive wins where they overlap (§2).
+//!
+//! [`Penumbra::Centred`] (issue 20) draws each sheet on both sides of its hard edge, so that t
+//! becomes the distance to the nearest silhouette in units of the local half width, inside the
+//! hard shadow as well as outside it; the technique keeps the hard shadow as a separate mask,
+//! which gives the distance its sign. Each vertex carries the silhouette point it measures from
+//! (its foot) and the edge's normal, so the GPU can drop the distances to silhouettes that do
+//! not lie on the hard shadow's boundary (interior folds, edges under another caster's shadow).
 
 use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
 
@@ -89,18 +96,21 @@ impl ReceiverPlane {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum PenumbraSize {
     /// From the light sphere: the footprint on the plane of the cone of rays from the vertex to
-    /// the light (width W = D·h/(H − h) under a light overhead), times `scale` (the outer-only
-    /// plateau starts where the true penumbra is half way, see `PLATEAU_SCALE`).
+    /// the light (width W = D·h/(H − h) under a light overhead): cone radius `scale` × W/2, the
+    /// true half width on each side of the hard edge at 1.
     Physical { scale: f32 },
     /// Haines §3: radius = factor × height (0.1 in most of the paper's images).
     Haines { factor: f32 },
 }
 
-/// The base of a vertex cone: an ellipse about the projected vertex (its apex),
-/// { centre + axes·x : |x| ≤ 1 }.
+/// A vertex cone: its apex, the projected vertex `centre`, over an elliptical base
+/// { centre + offset + axes·x : |x| ≤ 1 }.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cone {
     pub centre: Vec2,
+    /// From the apex to the base's centre: away from a low light, whose footprint reaches
+    /// further beyond the projected vertex than short of it.
+    pub offset: Vec2,
     /// Columns: the semi-major axis (pointing away from the light) and the semi-minor axis.
     pub axes: Mat2,
 }
@@ -108,14 +118,15 @@ pub struct Cone {
 impl Cone {
     /// The support function: max over the base of ν·x.
     fn support(&self, nu: Vec2) -> f32 {
-        nu.dot(self.centre) + (self.axes.transpose() * nu).length()
+        nu.dot(self.centre + self.offset) + (self.axes.transpose() * nu).length()
     }
 
     /// The point of the base where the tangent with outward normal ν touches it.
     fn support_point(&self, nu: Vec2) -> Vec2 {
         let a = self.axes.transpose() * nu;
         let len = a.length();
-        if len == 0.0 { self.centre } else { self.centre + self.axes * (a / len) }
+        let base = self.centre + self.offset;
+        if len == 0.0 { base } else { base + self.axes * (a / len) }
     }
 
     pub fn is_point(&self) -> bool {
@@ -130,14 +141,17 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
     let centre = plane.project(light, p)?;
     let h = plane.height(p);
     if h <= 0.0 || radius == 0.0 && matches!(size, PenumbraSize::Physical { .. }) {
-        return Some(Cone { centre, axes: Mat2::ZERO });
+        return Some(Cone { centre, offset: Vec2::ZERO, axes: Mat2::ZERO });
     }
     match size {
-        PenumbraSize::Haines { factor } => Some(Cone { centre, axes: Mat2::from_diagonal(Vec2::splat(factor * h)) }),
+        PenumbraSize::Haines { factor } => {
+            Some(Cone { centre, offset: Vec2::ZERO, axes: Mat2::from_diagonal(Vec2::splat(factor * h)) })
+        }
         PenumbraSize::Physical { scale } => {
             // The rays from p towards the light sphere form a cone of half-angle α about the
             // axis from the light through p, tilted θ from the plane's normal. Across the tilt
-            // its section spans h·tan(θ ± α); sideways about h·tan α / cos θ (§3's ellipse,
+            // its section spans h·tan(θ ± α) from p's foot, so its middle lies beyond the
+            // projected vertex (at h·tan θ); sideways about h·tan α / cos θ (§3's ellipse,
             // major axis away from the light).
             let axis = (p - plane.origin - (light - plane.origin)).normalize();
             let away = Vec2::new(axis.dot(plane.u), axis.dot(plane.v));
@@ -150,8 +164,13 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
             let tan = |x: f32| x.min(cap).tan();
             let semi_major = 0.5 * h * (tan(theta + alpha) - tan(theta - alpha));
             let semi_minor = h * tan(alpha) / theta.cos();
+            let beyond = 0.5 * h * (tan(theta + alpha) + tan(theta - alpha)) - h * theta.tan();
             let minor = major.perp();
-            Some(Cone { centre, axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale) })
+            Some(Cone {
+                centre,
+                offset: major * beyond * scale,
+                axes: Mat2::from_cols(major * semi_major * scale, minor * semi_minor * scale),
+            })
         }
     }
 }
@@ -178,18 +197,35 @@ pub fn outer_tangent(a: &Cone, b: &Cone, outward: Vec2) -> Option<(Vec2, Vec2)> 
     Some((a.support_point(n), b.support_point(n)))
 }
 
-/// A plateau vertex: plane coordinates and the plateau parameter t (0 dark, 1 lit).
+/// A plateau vertex: plane coordinates, the plateau parameter t (0 dark, 1 lit), the point of
+/// the silhouette it is measured from (a cone's apex, the sheet's hard edge), the edge's unit
+/// normal in the plane (zero on cones: there the direction to the vertex is the normal) and
+/// the caster's number, as the umbra mask writes it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct PlateauVertex {
     pub u: f32,
     pub v: f32,
     pub t: f32,
+    pub foot: [f32; 2],
+    pub normal: [f32; 2],
+    pub caster: f32,
+}
+
+/// Floats per location of a [`PlateauVertex`], for the vertex input.
+pub const PLATEAU_VERTEX_FLOATS: [u32; 4] = [3, 2, 2, 1];
+
+/// The silhouette a vertex is measured from, and its caster.
+#[derive(Clone, Copy, Debug)]
+struct Foot {
+    at: Vec2,
+    normal: Vec2,
+    caster: f32,
 }
 
 impl PlateauVertex {
-    fn new(p: Vec2, t: f32) -> Self {
-        PlateauVertex { u: p.x, v: p.y, t }
+    fn new(p: Vec2, t: f32, foot: Foot) -> Self {
+        PlateauVertex { u: p.x, v: p.y, t, foot: foot.at.into(), normal: foot.normal.into(), caster: foot.caster }
     }
 }
 
@@ -222,19 +258,20 @@ impl PlateauGeometry {
     }
 
     /// A cone as a triangle fan: apex at t = 0, base rim at t = 1.
-    fn push_cone(&mut self, cone: &Cone, segments: u32) {
+    fn push_cone(&mut self, cone: &Cone, segments: u32, caster: f32) {
         if cone.is_point() {
             return;
         }
         let rim = |k: u32| {
             let a = std::f32::consts::TAU * k as f32 / segments as f32;
-            cone.centre + cone.axes * Vec2::new(a.cos(), a.sin())
+            cone.centre + cone.offset + cone.axes * Vec2::new(a.cos(), a.sin())
         };
+        let foot = Foot { at: cone.centre, normal: Vec2::ZERO, caster };
         for k in 0..segments {
             self.cones.extend([
-                PlateauVertex::new(cone.centre, 0.0),
-                PlateauVertex::new(rim(k), 1.0),
-                PlateauVertex::new(rim(k + 1), 1.0),
+                PlateauVertex::new(cone.centre, 0.0, foot),
+                PlateauVertex::new(rim(k), 1.0, foot),
+                PlateauVertex::new(rim(k + 1), 1.0, foot),
             ]);
         }
     }
@@ -242,7 +279,8 @@ impl PlateauGeometry {
     /// The sheet between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1): a
     /// Coons patch bounded by four lines, tessellated so that Gouraud interpolation of t over
     /// each flat triangle strays from the bilinear patch by under 1% (paper Figure 4, §3).
-    fn push_sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2) {
+    /// `normal`: the edge's unit normal, `caster`: the caster's number (see [`PlateauVertex`]).
+    fn push_sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) {
         let width = (ta - a).length().min((tb - b).length()).max((ta - a).length().max((tb - b).length()) * 1e-3);
         if width == 0.0 {
             return;
@@ -251,7 +289,8 @@ impl PlateauGeometry {
         let n = ((twist / (0.04 * width)).sqrt().ceil() as usize).clamp(1, 32);
         let at = |i: usize, j: usize| {
             let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
-            PlateauVertex::new(a.lerp(b, s).lerp(ta.lerp(tb, s), t), t)
+            let foot = Foot { at: a.lerp(b, s), normal, caster };
+            PlateauVertex::new(foot.at.lerp(ta.lerp(tb, s), t), t, foot)
         };
         for i in 0..n {
             for j in 0..n {
@@ -262,22 +301,35 @@ impl PlateauGeometry {
     }
 }
 
+/// Where the penumbra lies about the hard shadow's edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Penumbra {
+    /// Haines §2: outward only, the whole hard shadow the umbra.
+    Outer,
+    /// Both sides, the hard edge in the middle (issue 20): sheets on the inner side too.
+    Centred,
+}
+
 /// The plateau settings of one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlateauLight {
     pub position: Vec3,
     pub radius: f32,
     pub size: PenumbraSize,
+    pub penumbra: Penumbra,
     /// Triangles per cone.
     pub cone_segments: u32,
 }
 
-/// The plateau sides of one caster: a cone per penumbra vertex (once, by `mailbox`) and a
-/// sheet along each penumbra edge, on its outer side.
+/// The plateau sides of one caster, numbered `number` (what its vertices carry): a cone per
+/// penumbra vertex (once, by `mailbox`) and a sheet along each penumbra edge, on its outer side
+/// and, centred, on its inner side.
+#[allow(clippy::too_many_arguments)] // the frame's plane, light and mailbox, and the caster
 pub fn plateau_sides(
     plane: &ReceiverPlane,
     light: &PlateauLight,
     caster: &Caster<'_>,
+    number: f32,
     source: EdgeSource,
     mailbox: &mut Mailbox,
     frame: u64,
@@ -289,7 +341,7 @@ pub fn plateau_sides(
         let (Some(ca), Some(cb)) = (cone(a), cone(b)) else { continue };
         for (v, c) in [(a, &ca), (b, &cb)] {
             if mailbox.first_visit(v, frame) {
-                out.push_cone(c, light.cone_segments);
+                out.push_cone(c, light.cone_segments, number);
                 out.grow(c.centre);
             }
         }
@@ -298,8 +350,16 @@ pub fn plateau_sides(
         let mid = 0.5 * (ca.centre + cb.centre);
         let along = (cb.centre - ca.centre).normalize_or_zero();
         let across = (mid - inside) - along * (mid - inside).dot(along);
-        if let Some((ta, tb)) = outer_tangent(&ca, &cb, across) {
-            out.push_sheet(ca.centre, cb.centre, ta, tb);
+        // An edge seen edge-on from its own triangle: either side (the GPU probes both).
+        let normal = across.try_normalize().unwrap_or(along.perp());
+        let sides: &[Vec2] = match light.penumbra {
+            Penumbra::Outer => &[normal],
+            Penumbra::Centred => &[normal, -normal],
+        };
+        for side in sides {
+            if let Some((ta, tb)) = outer_tangent(&ca, &cb, *side) {
+                out.push_sheet(ca.centre, cb.centre, ta, tb, normal, number);
+            }
         }
     }
     for p in out.cones.iter().chain(&out.sheets).map(|p| Vec2::new(p.u, p.v)).collect::<Vec<_>>() {
@@ -321,7 +381,7 @@ mod tests {
     use proptest::prelude::*;
 
     fn circle(x: f32, y: f32, r: f32) -> Cone {
-        Cone { centre: Vec2::new(x, y), axes: Mat2::from_diagonal(Vec2::splat(r)) }
+        Cone { centre: Vec2::new(x, y), offset: Vec2::ZERO, axes: Mat2::from_diagonal(Vec2::splat(r)) }
     }
 
     /// Two cone radii in `min..2`: equal in a third of the cases (a plate parallel to the plane,
@@ -393,7 +453,7 @@ mod tests {
             let mut g = PlateauGeometry::default();
             let (a, b) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1));
             let (ta, tb) = outer_tangent(&a, &b, Vec2::Y).unwrap();
-            g.push_sheet(a.centre, b.centre, ta, tb);
+            g.push_sheet(a.centre, b.centre, ta, tb, Vec2::Y, 1.0);
             prop_assert!(g.sheets.iter().all(|v| v.u.is_finite() && v.v.is_finite() && (0.0..=1.0).contains(&v.t)));
             let quads = g.sheets.len() / 6;
             if r0 == r1 {
@@ -404,7 +464,7 @@ mod tests {
             let mut wider = PlateauGeometry::default();
             let (a2, b2) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1 + (r1 - r0)));
             if let Some((ta2, tb2)) = outer_tangent(&a2, &b2, Vec2::Y) {
-                wider.push_sheet(a2.centre, b2.centre, ta2, tb2);
+                wider.push_sheet(a2.centre, b2.centre, ta2, tb2, Vec2::Y, 1.0);
                 prop_assert!(wider.sheets.len() / 6 >= quads || (r1 - r0).abs() < 1e-3);
             }
         }
@@ -440,11 +500,12 @@ mod tests {
             position: Vec3::new(2.0, 8.0, 1.0),
             radius: 0.5,
             size: PenumbraSize::Physical { scale: 1.0 },
+            penumbra: Penumbra::Outer,
             cone_segments: 8,
         };
         let plane = ReceiverPlane::ground(0.0);
         let mut mailbox = Mailbox::default();
-        let g = plateau_sides(&plane, &light, &caster, EdgeSource::Silhouettes, &mut mailbox, 1);
+        let g = plateau_sides(&plane, &light, &caster, 1.0, EdgeSource::Silhouettes, &mut mailbox, 1);
         let edges = penumbra_edges(&caster, &light_facing(&caster, light.position), EdgeSource::Silhouettes);
         let mut vertices: Vec<u32> = edges.iter().flat_map(|(e, _)| *e).collect();
         vertices.sort();
@@ -453,6 +514,49 @@ mod tests {
         assert_eq!(edges.len(), vertices.len(), "a convex silhouette is one loop");
         // The next frame draws them again; the same frame does not.
         assert!(mailbox.first_visit(vertices[0], 2) && !mailbox.first_visit(vertices[0], 2));
+    }
+
+    /// Centred: every edge gets a second sheet on the inner side, mirror to the outer one, and
+    /// every vertex measures t from its foot on the hard edge (t·radius away, flat plate).
+    #[test]
+    fn centred_sheets_straddle_the_hard_edge() {
+        let (cube, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let positions: Vec<Vec3> = cube.iter().map(|p| *p + Vec3::Y).collect();
+        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
+        let plane = ReceiverPlane::ground(0.0);
+        let sides = |penumbra| {
+            let light = PlateauLight {
+                position: Vec3::Y * 9.0,
+                radius: 0.5,
+                size: PenumbraSize::Physical { scale: 1.0 },
+                penumbra,
+                cone_segments: 8,
+            };
+            plateau_sides(&plane, &light, &caster, 3.0, EdgeSource::Silhouettes, &mut Mailbox::default(), 1)
+        };
+        let (outer, centred) = (sides(Penumbra::Outer), sides(Penumbra::Centred));
+        // A sheet more per edge (each tessellated by its own twist).
+        assert!(centred.sheets.len() > outer.sheets.len());
+        assert!(outer.sheets.iter().all(|v| centred.sheets.contains(v)));
+        assert_eq!(centred.cones, outer.cones);
+        // The top face (y = 1.05) casts the square |x|, |z| ≤ 9/7.95; the radius is W/2
+        // overhead, a few per cent more towards the corners (their cones lean out).
+        let half = 9.0 / 7.95;
+        let r = 0.5 * 1.05 / 7.95;
+        let (mut inside, mut outside) = (0, 0);
+        for v in &centred.sheets {
+            let (p, foot) = (Vec2::new(v.u, v.v), Vec2::from(v.foot));
+            assert!((foot.abs().max_element() - half).abs() < 1e-3, "the foot {foot} lies on the hard edge");
+            let d = (p - foot).length();
+            assert!(d >= v.t * r * 0.99 - 1e-4 && d <= v.t * r * 1.06 + 1e-4, "t {} at {d}", v.t);
+            assert!((Vec2::from(v.normal).length() - 1.0).abs() < 1e-5 && v.caster == 3.0);
+            match p.abs().max_element() < half - 1e-4 {
+                true => inside += 1,
+                false => outside += 1,
+            }
+        }
+        assert!(inside > 0 && outside > 0, "sheets on both sides: {inside} in, {outside} out");
     }
 
     #[test]
@@ -478,6 +582,11 @@ mod tests {
             assert!(major.length() >= minor.length() && major.length() > first, "{elevation}°");
             assert!(major.length() <= MAX_TILT_TAN * p.y, "{elevation}°: capped");
             assert!(major.x.abs() > 0.99 * major.length(), "the major axis points along the light's azimuth");
+            // The footprint reaches further beyond the projected vertex than short of it.
+            let away = major.normalize();
+            let (beyond, short) =
+                (cone.support(away) - away.dot(cone.centre), cone.support(-away) + away.dot(cone.centre));
+            assert!(beyond > short && short > 0.0, "{elevation}°: {beyond} beyond, {short} short");
         }
         // Touching the plane: a point; at or above the light: nothing.
         assert!(vertex_cone(&plane, Vec3::Y * 5.0, 0.5, size, Vec3::ZERO).unwrap().is_point());
@@ -513,7 +622,7 @@ mod tests {
                     );
                     assert!((tb - ta).perp_dot(along).abs() < tol, "not parallel to the centre line");
                     let mut g = PlateauGeometry::default();
-                    g.push_sheet(a.centre, b.centre, ta, tb);
+                    g.push_sheet(a.centre, b.centre, ta, tb, Vec2::Y, 1.0);
                     if r == 0.0 {
                         assert!(g.sheets.is_empty(), "point bases: a hard edge, no sheet");
                         continue;

@@ -9,8 +9,8 @@ use crate::error::{Error, Result};
 use crate::frame::Surfaces;
 use crate::measure::{Metrics, TimingReport};
 use crate::renderer::Capture;
-use crate::technique::registry::Setting;
-use crate::technique::{TECHNIQUES, TechniqueInfo};
+use crate::technique::registry::{self, Setting};
+use crate::technique::{TECHNIQUES, TechniqueInfo, plateau, shadow_map};
 
 /// One scene × technique × setting.
 #[derive(Clone, Debug)]
@@ -50,19 +50,34 @@ pub struct CostGoal {
     pub max_ratio: f64,
 }
 
-/// Every technique's cost goal, in registry order.
+/// Cost goals between settings, beyond each registry entry's own: issue 20's centred plateau
+/// (the default) against the outer-only form and against PCSS (16+16).
+pub const COST_GOALS: &[(&TechniqueInfo, registry::CostGoal)] = &[
+    (
+        &plateau::INFO,
+        registry::CostGoal {
+            setting: &[],
+            baseline: &plateau::INFO,
+            baseline_setting: plateau::OUTER_ONLY,
+            max_ratio: 1.15,
+        },
+    ),
+    (
+        &plateau::INFO,
+        registry::CostGoal { setting: &[], baseline: &shadow_map::PCSS, baseline_setting: &[], max_ratio: 0.7 },
+    ),
+];
+
+/// Every technique's cost goal, in registry order, then [`COST_GOALS`].
 pub fn registry_cost_goals() -> Vec<CostGoal> {
-    TECHNIQUES
-        .iter()
-        .filter_map(|t| {
-            let g = t.cost_goal?;
-            Some(CostGoal {
-                technique: t.name,
-                setting: setting_label(g.setting),
-                baseline: g.baseline.name,
-                baseline_setting: setting_label(g.baseline_setting),
-                max_ratio: g.max_ratio,
-            })
+    let own = TECHNIQUES.iter().filter_map(|t| t.cost_goal.map(|g| (*t, g)));
+    own.chain(COST_GOALS.iter().map(|(t, g)| (*t, *g)))
+        .map(|(t, g)| CostGoal {
+            technique: t.name,
+            setting: setting_label(g.setting),
+            baseline: g.baseline.name,
+            baseline_setting: setting_label(g.baseline_setting),
+            max_ratio: g.max_ratio,
         })
         .collect()
 }
@@ -343,6 +358,21 @@ mod tests {
             timings: TimingReport { gpu_ms_total_median: ms, ..Default::default() },
             metrics: Metrics::default(),
             pareto: false,
+        }
+    }
+
+    /// Both sides of every goal are settings the full sweep runs, so bench can check them.
+    #[test]
+    fn every_cost_goal_compares_benched_settings() {
+        let swept: Vec<(&str, String)> = sweep(false).iter().map(|(t, s)| (t.name, setting_label(s))).collect();
+        for g in registry_cost_goals() {
+            for side in [(g.technique, &g.setting), (g.baseline, &g.baseline_setting)] {
+                assert!(
+                    swept.iter().any(|(t, s)| *t == side.0 && s == side.1),
+                    "{}: {side:?} is not benched",
+                    g.label()
+                );
+            }
         }
     }
 

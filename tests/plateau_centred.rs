@@ -1,0 +1,231 @@
+//! Centred plateaus (issue 20) on lavapipe, against the GPU reference: the penumbra straddles the
+//! hard edge with the physical width, the umbra shrinks and vanishes as the light grows, no
+//! inner penumbra lightens what another caster or another part of the same caster blocks, the
+//! physical size is the error-minimising one, and the centred form beats the papers' outer-only
+//! form on every scene of the suite.
+
+mod common;
+
+use common::{engine, finish, reference, render_with, scene, suite_scene, top_down};
+use softshadow::Capture;
+use softshadow::measure::Metrics;
+use softshadow::scene::Scene;
+
+/// The papers' form at its best curve, as bench runs it.
+const OUTER: &[(&str, &str)] = &[("penumbra", "0"), ("falloff", "0")];
+
+/// A square plate of half size `half` at `height` under a light of `radius` straight above the
+/// origin at `light_height`, seen from above around x = `x` (`view` m each way).
+fn plate(half: f32, height: f32, light_height: f32, radius: f32, x: f32, view: f32) -> Scene {
+    let object = format!(
+        "[[object]]\nshape = \"plate\"\nsize = [{s}, 0.0, {s}]\nposition = [0.0, {height}, 0.0]\n",
+        s = 2.0 * half
+    );
+    top_down(x, view, [0.0, light_height, 0.0], radius, &object)
+}
+
+/// V along the image's middle row.
+fn row(c: &Capture) -> Vec<f32> {
+    (0..c.width).map(|x| c.visibility_at(x, c.height / 2)).collect()
+}
+
+/// The plate's edge at x = 1.2 m (half size 1, 1 m up, the light 6 m up): W = D·h/(H − h) =
+/// 0.2 m, seen 0.8 m across so the penumbra spans 32 of 128 px. Inside and outside, the widths
+/// from the hard edge to where V leaves [0.02, 0.98] (the same thresholds on both images).
+#[test]
+fn a_straight_plate_edge_penumbra_straddles_the_hard_edge() {
+    let s = plate(1.0, 1.0, 6.0, 0.5, 1.2, 0.4);
+    let mut e = engine();
+    let truth = row(&reference(&mut e, &s, 128));
+    let v = row(&render_with(&mut e, &s, "plateau", &[], 128));
+    let outer = row(&render_with(&mut e, &s, "plateau", OUTER, 128));
+    finish(e);
+    // Pixel x covers world 0.8 + (x + 0.5)·0.8/128: the hard edge falls between 63 and 64.
+    let edge = 0.5 * (v[63] + v[64]);
+    assert!((edge - 0.5).abs() <= 0.1, "V on the hard edge {edge}: {:?}", &v[56..72]);
+    let truth_edge = 0.5 * (truth[63] + truth[64]);
+    assert!((truth_edge - 0.5).abs() <= 0.1, "the reference's V on the hard edge {truth_edge}");
+    let widths = |v: &[f32]| {
+        let inner = (0..64).rev().take_while(|&x| v[x] >= 0.02).count();
+        let outer = (64..128).take_while(|&x| v[x] <= 0.98).count();
+        (inner as f32, outer as f32)
+    };
+    let ((inner, out), (truth_inner, truth_out)) = (widths(&v), widths(&truth));
+    assert!(truth_inner >= 8.0 && truth_out >= 8.0, "the reference's penumbra: {truth_inner} + {truth_out} px");
+    for (got, want, side) in [(inner, truth_inner, "inner"), (out, truth_out, "outer")] {
+        assert!((got - want).abs() <= 0.2 * want, "{side} width {got} px, the reference's {want} px");
+    }
+    // The papers' form keeps the whole hard shadow dark: nothing inside the edge.
+    assert!(widths(&outer).0 <= 1.0, "outer only: {:?}", widths(&outer));
+}
+
+/// A plate of half size 0.5 m, 2 m up, under a light 8 m up: from under its centre the plate
+/// covers the light while R/H ≤ a/h, so the umbra vanishes at R = a·H/h = 2 m. Seen at 45°
+/// (orthographic), so that the plate hides none of the middle row, the ground along x.
+#[test]
+fn the_umbra_shrinks_as_the_light_grows_and_vanishes_at_the_right_radius() {
+    let vanishing = 2.0;
+    let mut e = engine();
+    let mut last = usize::MAX;
+    for radius in [0.4, 1.0, 1.6, 0.85 * vanishing, 1.15 * vanishing, 1.4 * vanishing] {
+        let s = scene(&format!(
+            "[camera]\nposition = [0.0, 8.0, 8.0]\ntarget = [0.0, 0.0, 0.0]\northo_half_height = 1.5\n\
+             [light]\nposition = [0.0, 8.0, 0.0]\nradius = {radius}\n[ground]\nheight = 0.0\n\
+             [[object]]\nshape = \"plate\"\nsize = [1.0, 0.0, 1.0]\nposition = [0.0, 2.0, 0.0]\n"
+        ));
+        let v = row(&render_with(&mut e, &s, "plateau", &[], 96));
+        let truth = row(&reference(&mut e, &s, 96));
+        let umbra = |v: &[f32]| v.iter().filter(|&&v| v < 0.005).count();
+        let (got, want) = (umbra(&v), umbra(&truth));
+        assert!(got <= last, "R {radius}: the umbra grew from {last} to {got} px");
+        assert!(got.abs_diff(want) <= 2 + want / 5, "R {radius}: umbra {got} px, the reference's {want} px");
+        let centre = 0.5 * (v[47] + v[48]);
+        if radius < vanishing {
+            assert!(got > 0 && centre < 0.005, "R {radius}: an umbra under the centre (V {centre})");
+        } else {
+            assert!(got == 0 && centre > 0.005, "R {radius}: no umbra left (V {centre} under the centre)");
+        }
+        last = got;
+    }
+    finish(e);
+}
+
+/// Two plates whose shadows overlap, the lower one smaller and sharper: where one blocks, the
+/// other's inner penumbra must not lighten. Each pixel is no lighter than either plate's shadow
+/// alone, and within the hard shadows (of a point light at the light's centre) no lighter than
+/// the reference + 0.05. Outside both, two outer penumbrae combine by min as in Haines' plateau
+/// (§4), lighter than the truth's product where they cross: counted, not bounded.
+#[test]
+fn overlapping_plates_never_leak_light() {
+    let low = "[[object]]\nshape = \"plate\"\nsize = [1.2, 0.0, 1.2]\nposition = [0.5, 0.8, 0.3]\n";
+    let high = "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 2.0]\nposition = [-0.4, 2.5, 0.0]\n";
+    let at = |objects: &str, radius| top_down(0.0, 2.5, [0.3, 7.0, 0.2], radius, objects);
+    let mut e = engine();
+    let both = at(&format!("{low}{high}"), 0.6);
+    let truth = reference(&mut e, &both, 96);
+    let v = render_with(&mut e, &both, "plateau", &[], 96);
+    let hard = render_with(&mut e, &at(&format!("{low}{high}"), 0.0), "plateau", &[], 96);
+    let alone = [low, high].map(|o| render_with(&mut e, &at(o, 0.6), "plateau", &[], 96));
+    finish(e);
+    let (mut inside, mut lighter, mut crossing) = (0, 0, 0);
+    // Where the ground is seen: the plates hide some of it, and only the ground is compared.
+    let ground = (0..96 * 96).filter(|&i| v.surfaces.receives[i] && !v.surfaces.casts[i]);
+    for (x, y) in ground.map(|i| ((i % 96) as u32, (i / 96) as u32)) {
+        let got = v.visibility_at(x, y);
+        let single = alone.iter().map(|c| c.visibility_at(x, y)).fold(1.0, f32::min);
+        assert!(got <= single + 0.02, "({x}, {y}): V {got} over the single shadows' {single}");
+        let too_light = got > truth.visibility_at(x, y) + 0.05;
+        if hard.visibility_at(x, y) == 0.0 {
+            inside += 1;
+            lighter += usize::from(too_light);
+        } else {
+            crossing += usize::from(too_light);
+        }
+    }
+    eprintln!("outside the hard shadows, {crossing} px lighter than the reference + 0.05");
+    assert!(inside > 500, "the hard shadows cover {inside} px");
+    assert_eq!(lighter, 0, "{lighter} of {inside} px inside the hard shadows lighter than the reference + 0.05");
+}
+
+/// Silhouettes inside the hard shadow (the torus's far rim, the cow's legs and head under its
+/// body) are not its boundary: no bright streak inside the reference's umbra.
+#[test]
+fn interior_folds_make_no_streaks_in_the_umbra() {
+    let cow = scene(
+        r#"
+[camera]
+position = [0.0, 6.0, 0.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+ortho_half_height = 1.6
+[light]
+position = [0.6, 5.0, 0.4]
+radius = 0.3
+[ground]
+height = 0.0
+[[object]]
+shape = "mesh"
+mesh = "../models/spot_low_resolution.obj"
+position = [0.0, 0.9, 0.0]
+receives = false
+"#,
+    );
+    let mut e = engine();
+    for (name, s) in [("torus", suite_scene("torus")), ("cow", cow)] {
+        let truth = reference(&mut e, &s, 96);
+        let v = render_with(&mut e, &s, "plateau", &[], 96);
+        let umbra: Vec<usize> = (0..truth.visibility.len()).filter(|&i| truth.visibility[i] == 0).collect();
+        assert!(umbra.len() > 100, "{name}: the reference has an umbra ({} px)", umbra.len());
+        let worst = umbra.iter().map(|&i| v.visibility[i]).max().unwrap() as f32 / 65535.0;
+        assert!(worst <= 0.1, "{name}: V up to {worst} inside the reference's umbra");
+    }
+    finish(e);
+}
+
+/// The physical size is the right one: of the scales around it, the error against the reference
+/// is least within [0.8, 1.25] of it on the plate and the sphere.
+#[test]
+fn the_physical_penumbra_size_minimises_the_error() {
+    let scales = ["0.5", "0.65", "0.8", "1", "1.25", "1.6", "2"];
+    let mut e = engine();
+    for name in ["plate", "sphere"] {
+        let s = suite_scene(name);
+        let truth = reference(&mut e, &s, 96);
+        let errors: Vec<f64> = scales
+            .iter()
+            .map(|k| {
+                let v = render_with(&mut e, &s, "plateau", &[("penumbra_scale", k)], 96);
+                Metrics::between(&v, &truth).unwrap().penumbra_rmse
+            })
+            .collect();
+        let best = (0..scales.len()).min_by(|&a, &b| errors[a].total_cmp(&errors[b])).unwrap();
+        eprintln!("{name}: penumbra RMSE by scale {scales:?}: {errors:.4?}");
+        assert!((2..=4).contains(&best), "{name}: least error at scale {} ({errors:.4?})", scales[best]);
+    }
+    finish(e);
+}
+
+/// On every scene of the suite: within the registry's bound of the hard shadow, more accurate
+/// than the outer-only form in the penumbra and overall, and leaking hardly more light than it:
+/// at most 0.25 % of the pixels more. Strictly no more is not met: where the truth's penumbra is
+/// a pixel or two wide (near contact, the low light's box), V = ½ on a hard edge rasterised a
+/// pixel off the reference's (its 512² maps) counts as a leak where the outer-only V = 0 counts
+/// as too dark (low_light at 64²: 0.0194 against 0.0176).
+#[test]
+fn the_centred_form_beats_the_outer_only_form_on_every_suite_scene() {
+    let bound = softshadow::technique::find("plateau").unwrap().error_bound.expect("plateau claims a bound");
+    let mut e = engine();
+    let mut scenes: Vec<_> =
+        std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes")).unwrap().map(|f| f.unwrap().path()).collect();
+    scenes.sort();
+    assert_eq!(scenes.len(), 10, "the suite's ten scenes");
+    for path in scenes {
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let s = Scene::load(&path).unwrap();
+        let truth = reference(&mut e, &s, 64);
+        let mut metrics = |sets: &[(&str, &str)], technique| {
+            Metrics::between(&render_with(&mut e, &s, technique, sets, 64), &truth).unwrap()
+        };
+        let (centred, outer, hard) = (metrics(&[], "plateau"), metrics(OUTER, "plateau"), metrics(&[], "shadow-map"));
+        eprintln!(
+            "{name}: RMSE centred {:.4} outer {:.4} hard {:.4}; penumbra {:.4} vs {:.4}; leaks {:.4} vs {:.4}",
+            centred.rmse,
+            outer.rmse,
+            hard.rmse,
+            centred.penumbra_rmse,
+            outer.penumbra_rmse,
+            centred.leak_rate,
+            outer.leak_rate
+        );
+        assert!(centred.rmse <= hard.rmse + bound, "{name}: RMSE {} over the bound", centred.rmse);
+        assert!(centred.rmse < outer.rmse, "{name}: RMSE {} vs outer only {}", centred.rmse, outer.rmse);
+        assert!(centred.penumbra_rmse < outer.penumbra_rmse, "{name}: penumbra RMSE");
+        assert!(
+            centred.leak_rate <= outer.leak_rate + 0.0025,
+            "{name}: leaks {} vs {}",
+            centred.leak_rate,
+            outer.leak_rate
+        );
+    }
+    finish(e);
+}
