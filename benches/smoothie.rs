@@ -8,7 +8,7 @@ use std::path::Path;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use softshadow::geometry::silhouette::{Caster, Mailbox};
-use softshadow::geometry::smoothie::{SmoothieSize, silhouette, smoothies};
+use softshadow::geometry::smoothie::{Penumbra, SmoothieSize, silhouette, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
 
@@ -32,7 +32,7 @@ fn smoothie(c: &mut Criterion) {
     group.bench_function("smoothie geometry", |b| {
         b.iter(|| {
             frame += 1;
-            smoothies(&view, black_box(&caster), &edges, size, &mut mailbox, frame)
+            smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer, &mut mailbox, frame)
         })
     });
     group.finish();

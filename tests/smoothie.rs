@@ -96,7 +96,7 @@ fn extremes_stay_sane() {
     let lit = (pixel(-2.8), pixel(2.8));
     let cases: [Case; 5] = [
         ("t -> 0", plate.clone(), &[("t", "0.00001")]),
-        ("very large t", plate.clone(), &[("t", "1")]),
+        ("very large t", plate.clone(), &[("t", "1"), ("penumbra", "0")]),
         ("16-bit depth", plate.clone(), &[("depth16", "1")]),
         ("light far away", plate.clone().with_light_at(1e4), &[]),
         ("open mesh", lit_from(-4.0, 0.5, OPEN_BOX), &[]),

@@ -24,6 +24,12 @@ pub const FALLOFF: Knob = Knob {
     help: "gradient: 0 linear, 1 sine (Haines 3), 2 smoothstep (Parker), 3 disk edge (exact for a straight edge)",
 };
 
+/// Where the penumbra lies (issue 20): 0, the papers' outer-only form, grown outward from the
+/// hard shadow, whose whole area stays umbra (Haines §4, Chan & Durand §3); 1, centred on the
+/// hard edge with the physical width, V = ½ on the edge and the umbra shrinking as the light
+/// grows. A technique whose measured default differs declares `Knob { default: 1.0, ..PENUMBRA }`.
+pub const PENUMBRA: Knob = Knob::switch("penumbra", "penumbra: 0 outer only (the papers), 1 centred on the hard edge");
+
 const FORMAT: vk::Format = vk::Format::R16_UNORM;
 const SIZE: u32 = 256;
 /// Rows, in the order of the `falloff` knob's values.
