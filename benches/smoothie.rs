@@ -26,7 +26,7 @@ fn smoothie(c: &mut Criterion) {
     let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
     let view = frustum.view;
-    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, frustum.far);
+    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
     let mut mailbox = Mailbox::default();
     let mut frame = 0;
     group.bench_function("smoothie geometry", |b| {

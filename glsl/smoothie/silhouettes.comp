@@ -37,7 +37,7 @@ bool lit(uint face) {
 }
 
 float smoothie_t(float depth) {
-    return PHYSICAL_SIZE ? params.size.x / depth : params.size.x;
+    return PHYSICAL_SIZE ? params.size.x / (depth + params.light.x) : params.size.x;
 }
 
 float reach(float depth) {

@@ -73,7 +73,9 @@ pub struct SilhouetteParams {
     pub model_view: Mat4,
     pub size: Vec4,
     pub counts: [u32; 4],
-    pub pad: [Vec4; 10],
+    /// x: how far the light lies behind the view's origin.
+    pub light: Vec4,
+    pub pad: [Vec4; 9],
 }
 
 /// One hard shadow of an accumulation, padded to 256 bytes (see `LightSample`).

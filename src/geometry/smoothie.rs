@@ -77,8 +77,11 @@ pub enum SmoothieSize {
     /// t = `scale` · R / b for a vertex at light depth b, R the light's radius: the angular
     /// radius of the light seen from the blocker. With the remap α' = α / (1 − b/r) the alpha
     /// then reaches 1 at (R/b)(1 − b/r) from the silhouette, the true outer half-penumbra of a
-    /// straight edge on a receiver at depth r (similar triangles).
-    Physical { light_radius: f32, scale: f32 },
+    /// straight edge on a receiver at depth r (similar triangles). `behind`: how far the light
+    /// lies behind the view's origin, which the frustum fit moves closer for a far light
+    /// (depths there are offset by it, their differences are not; the angular radius is R over
+    /// the distance from the light itself).
+    Physical { light_radius: f32, scale: f32, behind: f32 },
     /// The paper's user parameter: one t for every smoothie.
     Fixed(f32),
 }
@@ -91,7 +94,7 @@ impl SmoothieSize {
 
     fn at(self, depth: f32) -> f32 {
         match self {
-            SmoothieSize::Physical { light_radius, scale } => scale * light_radius / depth,
+            SmoothieSize::Physical { light_radius, scale, behind } => scale * light_radius / (depth + behind),
             SmoothieSize::Fixed(t) => t,
         }
     }
@@ -296,8 +299,10 @@ mod tests {
 
     #[test]
     fn physical_size_is_the_light_s_angular_radius_from_the_blocker() {
-        let size = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0 };
+        let size = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0, behind: 0.0 };
         assert!((size.at(5.0) - 0.1).abs() < 1e-7);
+        let moved = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0, behind: 3.0 };
+        assert!((moved.at(2.0) - 0.1).abs() < 1e-7, "the light 3 behind the view's origin");
         assert_eq!(SmoothieSize::Fixed(0.02).at(123.0), 0.02);
     }
 

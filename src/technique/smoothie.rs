@@ -233,7 +233,11 @@ impl Technique for Smoothie {
         let smoothie_size = if t > 0.0 {
             SmoothieSize::Fixed(t)
         } else {
-            SmoothieSize::Physical { light_radius: frame.scene.light.radius, scale: params.get(&T_SCALE) as f32 }
+            SmoothieSize::Physical {
+                light_radius: frame.scene.light.radius,
+                scale: params.get(&T_SCALE) as f32,
+                behind: frustum.view.transform_point3(frame.scene.light.position).length(),
+            }
         };
         // Smoothies reach t beyond the casters' outline: the map and buffer must cover them.
         let frustum = frustum.grown(smoothie_size.largest_reach(frustum.near, frustum.far));
@@ -246,9 +250,11 @@ impl Technique for Smoothie {
         }
         let size = params.get(&MAP_SIZE) as u32;
         let buffer_size = params.get(&SMOOTHIE_SIZE) as u32;
-        // The ground's height (none: infinitely far below) and the light's, for r in pass 2.
+        // The ground's height (none: infinitely far below) and the light view origin's, for r in
+        // pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
-        let light_y = frame.scene.light.position.y;
+        // The view's origin, not the light: the fit moves it closer for a far light.
+        let light_y = frustum.view.inverse().w_axis.y;
         // What an empty map texel reads: the clear depth, which a 16-bit map saturates.
         let empty = if format == DEPTH_FORMAT { EMPTY_DEPTH } else { HALF_MAX };
         let kernel = Vec4::new(buffer_size as f32, empty, ground, light_y);

@@ -133,9 +133,9 @@ impl GpuSilhouettes {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
 
-        let (scale, physical) = match size {
-            SmoothieSize::Physical { light_radius, scale } => (light_radius * scale, true),
-            SmoothieSize::Fixed(t) => (t, false),
+        let (scale, behind, physical) = match size {
+            SmoothieSize::Physical { light_radius, scale, behind } => (light_radius * scale, behind, true),
+            SmoothieSize::Fixed(t) => (t, 0.0, false),
         };
         let pipeline = self.pipelines.get(physical, |&physical| {
             Pipeline::compute(
@@ -157,7 +157,8 @@ impl GpuSilhouettes {
                 model_view: *view * model,
                 size: Vec4::new(scale, near, far, caster_far),
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
-                pad: [Vec4::ZERO; 10],
+                light: Vec4::new(behind, 0.0, 0.0, 0.0),
+                pad: [Vec4::ZERO; 9],
             });
         }
         let params_buffer = self.params.as_mut().expect("ensured");
