@@ -27,6 +27,7 @@ struct Texels {
     vec2 base;    // texel (i0, j0)
     vec2 corner;  // where to gather them
     vec2 f;       // bilinear weights
+    vec4 b;       // the outer smoothies' depths
     vec4 behind;  // 1 where the receiver lies behind the texel's outer smoothie
 };
 
@@ -37,7 +38,8 @@ Texels texels(vec2 uv, float depth) {
     t.base = floor(pos);
     t.corner = (t.base + 1.0) / size;
     t.f = fract(pos);
-    t.behind = vec4(greaterThan(vec4(depth), textureGather(smoothies, t.corner, 0)));
+    t.b = textureGather(smoothies, t.corner, 0);
+    t.behind = vec4(greaterThan(vec4(depth), t.b));
     return t;
 }
 
@@ -76,10 +78,13 @@ float centred_test(vec2 uv, float depth, float umbra) {
         vec2 centre = (t.base + offsets[k] + 0.5) / size;
         caster[k] = texelFetch(shadow_map, min(ivec2(centre * map_size), last), 0).r;
     }
-    // Lit: the outer half. Shadowed: only an inner half lightens it (an outer smoothie there
-    // belongs to an edge this caster hides).
+    // Lit: the outer half. Shadowed: only an inner half lightens it, darkened by the outer
+    // penumbra of a caster in front of the map's (blockers taken as independent, which errs
+    // dark; the caster's own outer smoothies, at its depth, are no other blocker).
     vec4 lit = 0.5 + 0.5 * outer;
-    vec4 shadowed = inner * (0.5 - 0.5 * a);
+    float slack = 2.0 * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / map_size;
+    vec4 in_front = t.behind * vec4(lessThan(t.b, caster * (1.0 - slack)));
+    vec4 shadowed = inner * (0.5 - 0.5 * a) * mix(vec4(1.0), lit, in_front);
     return falloff_at(falloff, FALLOFF, bilinear(t, mix(lit, shadowed, vec4(lessThan(caster, vec4(depth))))));
 }
 
