@@ -107,7 +107,12 @@ fn overlapping_plates_never_leak_light() {
     let outer = render_with(&mut e, &s, "smoothie", OUTER, 128);
     let (leaks, outer_leaks) = (lighter(&centred, &truth), lighter(&outer, &truth));
     eprintln!("lighter than the truth + 0.05: centred {leaks} px, outer only {outer_leaks} px");
-    assert!(leaks <= outer_leaks.max(8), "centred {leaks} px, outer only {outer_leaks}");
+    // Gross leaks (the metric's) no more often than the papers' form, and lighter than the
+    // truth by 0.05 on at most 0.1 % of the frame: where two outer penumbrae cross, minimum
+    // blending keeps one of them (Chan & Durand §3.1), the truth darkens by both.
+    let rate = |c: &Capture| Metrics::between(c, &truth).unwrap().leak_rate;
+    assert!(rate(&centred) <= rate(&outer), "leak rate {} vs outer only {}", rate(&centred), rate(&outer));
+    assert!(leaks * 1000 <= truth.visibility.len(), "centred {leaks} px lighter than the truth + 0.05");
     finish(e);
 }
 

@@ -10,7 +10,7 @@ mod timings;
 mod trace;
 
 pub use metrics::{GROSS_ERROR, Metrics, PENUMBRA, save_difference};
-pub use plot::tradeoff;
+pub use plot::{curves, tradeoff};
 pub use sheet::{Tile, contact_sheet};
 pub use timings::{PassSummary, TimingReport};
 pub use trace::{FileTrace, Trace};

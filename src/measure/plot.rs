@@ -1,5 +1,6 @@
 //! `tradeoff.png`: penumbra RMSE against GPU ms, a series per technique, the Pareto frontier
-//! drawn. Text uses Debian's DejaVu Sans through ab_glyph (no system font lookup).
+//! drawn; and plain curves (a penumbra profile, an error against a knob). Text uses Debian's
+//! DejaVu Sans through ab_glyph (no system font lookup).
 
 use std::path::Path;
 
@@ -92,6 +93,46 @@ pub fn tradeoff(rows: &[BenchRow], path: &Path) -> Result<()> {
                 .label("Pareto frontier (per scene)")
                 .legend(|(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], BLACK.stroke_width(2)));
         }
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .draw()
+        .map_err(|e| plot_error(path, e))?;
+    root.present().map_err(|e| plot_error(path, e))
+}
+
+/// Curves (name, points) as lines on one chart: a penumbra profile, an error against a knob.
+pub fn curves(curves: &[(&str, Vec<(f64, f64)>)], (title, x, y): (&str, &str, &str), path: &Path) -> Result<()> {
+    register_sans(path)?;
+    let points = || curves.iter().flat_map(|(_, c)| c.iter());
+    let (x0, x1) = points().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let y1 = points().fold(0.0, |a: f64, p| a.max(p.1)) * 1.05;
+    let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, 0.0..y1.max(f64::MIN_POSITIVE))
+        .map_err(|e| plot_error(path, e))?;
+    chart
+        .configure_mesh()
+        .x_desc(x)
+        .y_desc(y)
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(|e| plot_error(path, e))?;
+    for (i, (name, points)) in curves.iter().enumerate() {
+        let color = COLORS[i % COLORS.len()];
+        chart
+            .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
+            .map_err(|e| plot_error(path, e))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], color.stroke_width(2)));
     }
     chart
         .configure_series_labels()
