@@ -97,6 +97,9 @@ const T: Knob = Knob {
     integer: false,
     help: "smoothie size in the light's tangent units; 0: from the light radius (t_scale R / b)",
 };
+/// The physical size by default: centred, the penumbra RMSE is least there (256², against the
+/// reference): plate 0.058, 0.028, 0.057 at 0.8, 1, 1.25; sphere 0.099, 0.088, 0.101
+/// (examples/smoothie_profile.rs, docs/smoothie_t_scale.png).
 const T_SCALE: Knob = Knob {
     name: "t_scale",
     default: 1.0,
@@ -105,9 +108,12 @@ const T_SCALE: Knob = Knob {
     integer: false,
     help: "with t = 0: smoothie size as a multiple of the light's angular radius from the blocker",
 };
-/// Centred: what measured better (see the module's note and docs/bench).
+/// Centred: what measured better. bench, 10 scenes, 512², against the reference (lavapipe):
+/// median penumbra RMSE 0.051 centred, 0.307 outer only (linear curve), 0.073 PCSS 16 + 16.
 const CENTRED: Knob = Knob { default: 1.0, ..PENUMBRA };
-/// The disk edge (curve 3), exact for a straight edge over the centred width.
+/// The disk edge (curve 3), exact for a straight edge over the centred width; penumbra RMSE at
+/// 256² against linear: plate 0.028 / 0.050, sphere 0.088 / 0.096, default 0.112 / 0.117,
+/// overlap 0.072 / 0.083, low_light 0.204 / 0.206.
 const SMOOTHIE_FALLOFF: Knob = Knob { default: 3.0, ..FALLOFF };
 const DEPTH16: Knob = Knob {
     name: "depth16",
