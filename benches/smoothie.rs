@@ -8,7 +8,7 @@ use std::path::Path;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use softshadow::geometry::silhouette::{Caster, Mailbox};
-use softshadow::geometry::smoothie::{SmoothieSize, silhouette, smoothies};
+use softshadow::geometry::smoothie::{Penumbra, SmoothieSize, silhouette, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
 
@@ -26,13 +26,13 @@ fn smoothie(c: &mut Criterion) {
     let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
     let view = frustum.view;
-    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 0.3 }, frustum.far);
+    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
     let mut mailbox = Mailbox::default();
     let mut frame = 0;
     group.bench_function("smoothie geometry", |b| {
         b.iter(|| {
             frame += 1;
-            smoothies(&view, black_box(&caster), &edges, size, &mut mailbox, frame)
+            smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer, &mut mailbox, frame)
         })
     });
     group.finish();

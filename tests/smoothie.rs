@@ -71,12 +71,14 @@ fn overlapping_blockers_are_never_darker_than_the_darker_one_alone() {
     let one = "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 2.0]\nposition = [-0.6, 2.0, 0.0]\n";
     let two = "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 2.0]\nposition = [0.6, 3.5, 0.6]\n";
     let mut e = engine();
-    let sets = [("t_scale", "1")];
+    let sets = [("penumbra", "0")];
     let a = render_with(&mut e, &top_down(0.6, one), "smoothie", &sets, SIZE);
     let b = render_with(&mut e, &top_down(0.6, two), "smoothie", &sets, SIZE);
     let both = render_with(&mut e, &top_down(0.6, &format!("{one}{two}")), "smoothie", &sets, SIZE);
     // Where both penumbrae overlap (umbra edges move by a texel between renders whose light
-    // frusta differ), within 3%: min blending keeps the lighter of two smoothies' alphas.
+    // frusta differ), within 3%: min blending keeps the lighter of two smoothies' alphas (the
+    // papers' outer-only form; centred, an inner half never lightens what another caster hides,
+    // tests/smoothie_centred.rs).
     let soft = |c: &Capture, i: usize| (1311..64224).contains(&c.visibility[i]);
     let darker = |i: usize| a.visibility[i].min(b.visibility[i]) as u32;
     let overlap: Vec<usize> = (0..both.visibility.len()).filter(|&i| soft(&a, i) && soft(&b, i)).collect();
@@ -96,7 +98,7 @@ fn extremes_stay_sane() {
     let lit = (pixel(-2.8), pixel(2.8));
     let cases: [Case; 5] = [
         ("t -> 0", plate.clone(), &[("t", "0.00001")]),
-        ("very large t", plate.clone(), &[("t", "1")]),
+        ("very large t", plate.clone(), &[("t", "1"), ("penumbra", "0")]),
         ("16-bit depth", plate.clone(), &[("depth16", "1")]),
         ("light far away", plate.clone().with_light_at(1e4), &[]),
         ("open mesh", lit_from(-4.0, 0.5, OPEN_BOX), &[]),

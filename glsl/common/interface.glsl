@@ -31,7 +31,7 @@ struct LightView {
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
     vec4 kernel;     // PCF: taps, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
                      // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
-                     // smoothie: buffer size, unused, ground height, light height
+                     // smoothie: buffer size, an empty map texel's depth, ground height, light height
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the
@@ -57,9 +57,11 @@ struct PlateauView {
 // them can be bound one element at a time as a uniform buffer.
 struct SilhouetteParams {
     mat4 model_view;  // object -> light view (+z away from the light)
-    vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver
-    uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices
-    vec4 pad[10];
+    vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver;
+                      // y, w: the caster's light-depth range (inner quads)
+    uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices, w: 1 for inner quads
+    vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE)
+    vec4 pad[9];
 };
 
 // One caster's shadow volume from one light point, built on the GPU (shadow-volume,

@@ -18,7 +18,9 @@ layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
 layout(std430, set = 0, binding = 5) buffer Args { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
-layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; }; // x, y, b, sx, sy
+// x, y, b, sx, sy, fx, fy, nx, ny, near, far (src/geometry/smoothie.rs's SmoothieVertex)
+layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
+const uint FLOATS = 11u;
 
 vec3 view_position(uint v) {
     return (params.model_view * vec4(positions[v].xyz, 1.0)).xyz;
@@ -35,32 +37,42 @@ bool lit(uint face) {
 }
 
 float smoothie_t(float depth) {
-    return PHYSICAL_SIZE ? params.size.x / depth : params.size.x;
+    return PHYSICAL_SIZE ? params.size.x / (depth + params.light.x) : params.size.x;
 }
 
 float reach(float depth) {
     return clamp(1.0 - depth / params.size.z, 0.0, 1.0);
 }
 
-void put(uint at, vec2 p, float b, vec2 shape) {
-    vertices[5 * at + 0] = p.x;
-    vertices[5 * at + 1] = p.y;
-    vertices[5 * at + 2] = b;
-    vertices[5 * at + 3] = shape.x;
-    vertices[5 * at + 4] = shape.y;
+// Inner quads' extra data: each vertex's point on the edge, the edge's outward normal, the
+// caster's depth range; zero for the outer smoothies.
+struct Inner {
+    vec2 foot[4];
+    vec2 normal;
+    vec2 range;
+};
+
+void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 range) {
+    float v[11] = float[11](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y);
+    for (uint k = 0u; k < FLOATS; k++) {
+        vertices[FLOATS * at + k] = v[k];
+    }
 }
 
 // Six vertices, two triangles: the quad q0 q1 q2 q3.
-void quad(vec2 q[4], float b[4], vec2 s[4]) {
+void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner) {
     uint at = atomicAdd(vertex_count, 6u);
     if (at + 6u > params.counts.z) {
         return; // sized so that it never happens; never write past the buffer
     }
     const int order[6] = int[6](0, 1, 2, 0, 2, 3);
     for (int k = 0; k < 6; k++) {
-        put(at + uint(k), q[order[k]], b[order[k]], s[order[k]]);
+        int o = order[k];
+        put(at + uint(k), q[o], b[o], s[o], inner.foot[o], inner.normal, inner.range);
     }
 }
+
+const Inner OUTER = Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(0.0));
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -91,7 +103,7 @@ void main() {
             vec2 q[4] = vec2[4](tv[k] + c[0] * r, tv[k] + c[1] * r, tv[k] + c[2] * r, tv[k] + c[3] * r);
             float b[4] = float[4](zv[k], zv[k], zv[k], zv[k]);
             vec2 s[4] = vec2[4](c[0] * kk, c[1] * kk, c[2] * kk, c[3] * kk);
-            quad(q, b, s);
+            quad(q, b, s, OUTER);
         }
     }
     vec2 along = tb - ta;
@@ -102,8 +114,12 @@ void main() {
     vec2 perp = vec2(-along.y, along.x);
     vec2 normal = dot(perp, pi.xy / pi.z - ta) > 0.0 ? -perp : perp;
     float ka = reach(pa.z), kb = reach(pb.z);
-    vec2 q[4] = vec2[4](ta, tb, tb + normal * smoothie_t(pb.z) * kb, ta + normal * smoothie_t(pa.z) * ka);
+    vec2 da = normal * smoothie_t(pa.z) * ka, db = normal * smoothie_t(pb.z) * kb;
     float b[4] = float[4](pa.z, pb.z, pb.z, pa.z);
     vec2 s[4] = vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0));
-    quad(q, b, s);
+    quad(vec2[4](ta, tb, tb + db, ta + da), b, s, OUTER);
+    if (params.counts.w != 0u) {
+        // The inner quad, mirrored over the blocker (issue 20).
+        quad(vec2[4](ta, tb, tb - db, ta - da), b, s, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw));
+    }
 }

@@ -73,7 +73,9 @@ pub struct SilhouetteParams {
     pub model_view: Mat4,
     pub size: Vec4,
     pub counts: [u32; 4],
-    pub pad: [Vec4; 10],
+    /// x: how far the light lies behind the view's origin.
+    pub light: Vec4,
+    pub pad: [Vec4; 9],
 }
 
 /// One caster's shadow volume from one light point, built on the GPU, padded to 256 bytes

@@ -11,9 +11,20 @@
 //! paper's wedges between two edges: they cover every direction around the vertex, so the §3
 //! special case (averaging normals at vertices with more than two silhouette edges) is never
 //! needed, and minimum blending keeps the overlap with the edges continuous.
+//!
+//! Beyond the paper (issue 20): with [`Penumbra::Centred`] each edge also gets an *inner* quad,
+//! the mirror of its smoothie edge over the blocker, so the penumbra straddles the hard edge as
+//! the truth's does: the true penumbra of a straight edge spans (R/b)(1 − b/r) on *each* side
+//! of the hard edge in the light's tangent plane (similar triangles through the edge from both
+//! rims of the light). Inner vertices carry what the smoothie pass needs to accept them only
+//! where the edge bounds this caster's own hard shadow (`glsl/smoothie/smoothie.frag`): the
+//! point of the edge they belong to, its outward normal and the caster's light-depth range.
+//! Inner corners are not needed: inside a convex corner the two edges' inner quads overlap, and
+//! minimum blending keeps the darker, as the outer corners' squares already cover the outside.
 
 use glam::{Mat4, Vec2, Vec3};
 
+use super::Aabb;
 use super::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
@@ -31,6 +42,33 @@ pub struct SmoothieVertex {
     /// |shape| is the linear alpha.
     pub sx: f32,
     pub sy: f32,
+    /// Inner quads: the point of the silhouette edge this vertex belongs to and the edge's
+    /// outward normal, tangent coordinates; zero elsewhere.
+    pub fx: f32,
+    pub fy: f32,
+    pub nx: f32,
+    pub ny: f32,
+    /// Inner quads: the caster's light-depth range; (0, 0) marks the outer smoothies.
+    pub near: f32,
+    pub far: f32,
+}
+
+/// Which side of the hard edge the smoothies cover (the `penumbra` knob).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Penumbra {
+    /// The paper's: outward only, the hard shadow all umbra (§3).
+    Outer,
+    /// Both sides: inner quads too, for a caster whose surfaces lie between light depths
+    /// `near` and `far` (see [`depth_range`]).
+    Centred { near: f32, far: f32 },
+}
+
+/// The light-depth range of a box seen through `view`, conservative: what [`Penumbra::Centred`]
+/// takes, from a caster's bounds (cheap on the compute path, exact enough for the acceptance
+/// test, which only needs to tell this caster from another in front of or behind it).
+pub fn depth_range(view: &Mat4, bounds: &Aabb) -> (f32, f32) {
+    let b = bounds.transformed(view);
+    (b.min.z, b.max.z)
 }
 
 /// The smoothie size t, in tangent units of the light view.
@@ -39,8 +77,11 @@ pub enum SmoothieSize {
     /// t = `scale` · R / b for a vertex at light depth b, R the light's radius: the angular
     /// radius of the light seen from the blocker. With the remap α' = α / (1 − b/r) the alpha
     /// then reaches 1 at (R/b)(1 − b/r) from the silhouette, the true outer half-penumbra of a
-    /// straight edge on a receiver at depth r (similar triangles).
-    Physical { light_radius: f32, scale: f32 },
+    /// straight edge on a receiver at depth r (similar triangles). `behind`: how far the light
+    /// lies behind the view's origin, which the frustum fit moves closer for a far light
+    /// (depths there are offset by it, their differences are not; the angular radius is R over
+    /// the distance from the light itself).
+    Physical { light_radius: f32, scale: f32, behind: f32 },
     /// The paper's user parameter: one t for every smoothie.
     Fixed(f32),
 }
@@ -53,7 +94,7 @@ impl SmoothieSize {
 
     fn at(self, depth: f32) -> f32 {
         match self {
-            SmoothieSize::Physical { light_radius, scale } => scale * light_radius / depth,
+            SmoothieSize::Physical { light_radius, scale, behind } => scale * light_radius / (depth + behind),
             SmoothieSize::Fixed(t) => t,
         }
     }
@@ -64,16 +105,24 @@ impl SmoothieSize {
 pub struct SmoothieGeometry {
     pub edges: Vec<SmoothieVertex>,
     pub corners: Vec<SmoothieVertex>,
+    /// The edges' inner quads ([`Penumbra::Centred`]).
+    pub inner: Vec<SmoothieVertex>,
 }
 
 impl SmoothieGeometry {
     pub fn extend(&mut self, other: &SmoothieGeometry) {
         self.edges.extend_from_slice(&other.edges);
         self.corners.extend_from_slice(&other.corners);
+        self.inner.extend_from_slice(&other.inner);
     }
 
     pub fn is_empty(&self) -> bool {
-        self.edges.is_empty() && self.corners.is_empty()
+        self.edges.is_empty() && self.corners.is_empty() && self.inner.is_empty()
+    }
+
+    /// Every vertex, in drawing order.
+    pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
+        self.edges.iter().chain(&self.corners).chain(&self.inner)
     }
 }
 
@@ -85,7 +134,24 @@ fn reach(b: f32, far: f32) -> f32 {
 }
 
 fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
-    SmoothieVertex { x: p.x, y: p.y, b, sx: shape.x, sy: shape.y }
+    SmoothieVertex {
+        x: p.x,
+        y: p.y,
+        b,
+        sx: shape.x,
+        sy: shape.y,
+        fx: 0.0,
+        fy: 0.0,
+        nx: 0.0,
+        ny: 0.0,
+        near: 0.0,
+        far: 0.0,
+    }
+}
+
+/// An inner-quad vertex at `p` belonging to the edge's point `foot`.
+fn inner_vertex(p: Vec2, b: f32, alpha: f32, (foot, normal): (Vec2, Vec2), (near, far): (f32, f32)) -> SmoothieVertex {
+    SmoothieVertex { fx: foot.x, fy: foot.y, nx: normal.x, ny: normal.y, near, far, ..vertex(p, b, Vec2::X * alpha) }
 }
 
 fn quad(out: &mut Vec<SmoothieVertex>, v: [SmoothieVertex; 4]) {
@@ -100,12 +166,13 @@ pub fn silhouette(caster: &Caster<'_>, light: Vec3) -> Vec<([u32; 2], u32)> {
 
 /// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (world →
 /// light view, +z away from the light), for receivers no farther than `far`. Each silhouette
-/// vertex gets one corner (`mailbox`).
+/// vertex gets one corner (`mailbox`); with [`Penumbra::Centred`] each edge an inner quad too.
 pub fn smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[([u32; 2], u32)],
     (size, far): (SmoothieSize, f32),
+    penumbra: Penumbra,
     mailbox: &mut Mailbox,
     frame: u64,
 ) -> SmoothieGeometry {
@@ -138,6 +205,18 @@ pub fn smoothies(
                 vertex(pa + normal * ta, za, Vec2::X * ka),
             ],
         );
+        if let Penumbra::Centred { near, far } = penumbra {
+            let range = (near, far);
+            quad(
+                &mut out.inner,
+                [
+                    inner_vertex(pa, za, 0.0, (pa, normal), range),
+                    inner_vertex(pb, zb, 0.0, (pb, normal), range),
+                    inner_vertex(pb - normal * tb, zb, kb, (pb, normal), range),
+                    inner_vertex(pa - normal * ta, za, ka, (pa, normal), range),
+                ],
+            );
+        }
     }
     out
 }
@@ -168,7 +247,8 @@ mod tests {
             let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
             let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
             prop_assert_eq!(edges.len(), 4, "a plate under the light: its outline");
-            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), &mut Mailbox::default(), 1);
+            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), Penumbra::Outer, &mut Mailbox::default(), 1);
+            prop_assert!(g.inner.is_empty(), "outer only: no inner quads");
             prop_assert_eq!(g.edges.len(), 4 * 6);
             prop_assert_eq!(g.corners.len(), 4 * 6, "one corner per silhouette vertex");
             let half = 0.5 / (10.0 - height);
@@ -186,10 +266,43 @@ mod tests {
         }
     }
 
+    /// Any depth range: only the shaders read it.
+    const CENTRED: Penumbra = Penumbra::Centred { near: 1.0, far: 2.0 };
+
+    proptest! {
+        #[test]
+        fn inner_quads_mirror_the_edges_over_the_blocker(height in 0.5f32..5.0, t in 0.001f32..0.2) {
+            let (positions, triangles, adjacency) = plate(height);
+            let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
+            let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+            let size = (SmoothieSize::Fixed(t), f32::INFINITY);
+            let g = smoothies(&down(), &caster, &edges, size, CENTRED, &mut Mailbox::default(), 1);
+            prop_assert_eq!(g.inner.len(), 4 * 6, "one inner quad per silhouette edge");
+            let half = 0.5 / (10.0 - height);
+            for v in &g.inner {
+                let (p, foot, normal) = (Vec2::new(v.x, v.y), Vec2::new(v.fx, v.fy), Vec2::new(v.nx, v.ny));
+                prop_assert!(v.sx == 0.0 || v.sx == 1.0, "alpha 0 on the outline, 1 at t inside it");
+                prop_assert!((foot.x.abs().max(foot.y.abs()) - half).abs() < 1e-4, "the foot lies on the outline");
+                prop_assert!((normal.length() - 1.0).abs() < 1e-5 && normal.dot(foot) > 0.0, "outward: {normal}");
+                prop_assert!(((p - foot).dot(normal) + v.sx * t).abs() < 1e-5, "alpha is the depth inside / t");
+                prop_assert!((p - foot).perp_dot(normal).abs() < 1e-6, "straight in from the foot");
+                prop_assert_eq!((v.near, v.far), (1.0, 2.0));
+            }
+        }
+    }
+
+    #[test]
+    fn depth_range_holds_the_whole_box() {
+        let bounds = Aabb { min: Vec3::new(-1.0, 2.0, -1.0), max: Vec3::new(1.0, 3.0, 1.0) };
+        assert_eq!(depth_range(&down(), &bounds), (7.0, 8.0));
+    }
+
     #[test]
     fn physical_size_is_the_light_s_angular_radius_from_the_blocker() {
-        let size = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0 };
+        let size = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0, behind: 0.0 };
         assert!((size.at(5.0) - 0.1).abs() < 1e-7);
+        let moved = SmoothieSize::Physical { light_radius: 0.5, scale: 1.0, behind: 3.0 };
+        assert!((moved.at(2.0) - 0.1).abs() < 1e-7, "the light 3 behind the view's origin");
         assert_eq!(SmoothieSize::Fixed(0.02).at(123.0), 0.02);
     }
 
@@ -198,8 +311,15 @@ mod tests {
         let (positions, triangles, adjacency) = plate(12.0); // above the light at y = 10
         let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
         let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
-        let g =
-            smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(0.1), f32::INFINITY), &mut Mailbox::default(), 1);
+        let g = smoothies(
+            &down(),
+            &caster,
+            &edges,
+            (SmoothieSize::Fixed(0.1), f32::INFINITY),
+            CENTRED,
+            &mut Mailbox::default(),
+            1,
+        );
         assert!(g.is_empty());
     }
 }

@@ -8,10 +8,11 @@ use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec4};
 
+use super::smoothie::penumbra;
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
-use crate::geometry::smoothie::SmoothieSize;
+use crate::geometry::smoothie::{Penumbra, SmoothieSize};
 use crate::gpu::{
     Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Variants, buffer_barrier,
     dispatch, shaders, update_buffer, upload,
@@ -20,8 +21,8 @@ use crate::scene::{Mesh, MeshId};
 
 const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
-/// Bytes per smoothie vertex: x, y, b, sx, sy.
-const VERTEX_BYTES: u64 = 20;
+/// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
+const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -99,8 +100,8 @@ impl GpuSilhouettes {
         &mut self,
         frame: &mut FrameInputs<'_>,
         view: &Mat4,
-        size: SmoothieSize,
-        far: f32,
+        (size, far): (SmoothieSize, f32),
+        centred: bool,
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
@@ -109,8 +110,12 @@ impl GpuSilhouettes {
                 self.meshes.push((o.mesh.id(), MeshBuffers::new(ctx, &o.mesh)?));
             }
         }
-        let capacity: u64 =
-            casters.iter().map(|o| 6 * (o.mesh.adjacency.edges.len() + o.mesh.positions.len()) as u64).sum();
+        // Six vertices per edge (twice, with the inner quads) and per corner.
+        let quads_per_edge = 1 + centred as usize;
+        let capacity: u64 = casters
+            .iter()
+            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + o.mesh.positions.len()) as u64)
+            .sum();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         PerFrame::ensure(
             ctx,
@@ -128,9 +133,9 @@ impl GpuSilhouettes {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
 
-        let (scale, physical) = match size {
-            SmoothieSize::Physical { light_radius, scale } => (light_radius * scale, true),
-            SmoothieSize::Fixed(t) => (t, false),
+        let (scale, behind, physical) = match size {
+            SmoothieSize::Physical { light_radius, scale, behind } => (light_radius * scale, behind, true),
+            SmoothieSize::Fixed(t) => (t, 0.0, false),
         };
         let pipeline = self.pipelines.get(physical, |&physical| {
             Pipeline::compute(
@@ -143,11 +148,17 @@ impl GpuSilhouettes {
         let mut params = Vec::with_capacity(casters.len());
         for o in &casters {
             self.stamp = self.stamp.wrapping_add(1).max(1);
+            let model = o.transform.matrix();
+            let (near, caster_far) = match penumbra(centred, view, &o.mesh.bounds.transformed(&model)) {
+                Penumbra::Centred { near, far } => (near, far),
+                Penumbra::Outer => (0.0, 0.0),
+            };
             params.push(SilhouetteParams {
-                model_view: *view * o.transform.matrix(),
-                size: Vec4::new(scale, 0.0, far, 0.0),
-                counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, 0],
-                pad: [Vec4::ZERO; 10],
+                model_view: *view * model,
+                size: Vec4::new(scale, near, far, caster_far),
+                counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
+                light: Vec4::new(behind, 0.0, 0.0, 0.0),
+                pad: [Vec4::ZERO; 9],
             });
         }
         let params_buffer = self.params.as_mut().expect("ensured");
