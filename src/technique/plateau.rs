@@ -31,7 +31,7 @@ use super::falloff::{FALLOFF, Falloff};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::{Technique, clear_visibility, refuse_wide_lights, resolve, surface_inputs};
+use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -241,7 +241,6 @@ impl Technique for Plateau {
         };
         let ctx = frame.ctx;
         let plane = ReceiverPlane::ground(ground.height);
-        let scene_light = &frame.scene.light;
         refuse_wide_lights(
             frame.scene,
             "plateau",
@@ -253,12 +252,8 @@ impl Technique for Plateau {
         } else {
             PenumbraSize::Physical { scale: params.get(&PENUMBRA_SCALE) as f32 }
         };
-        let light = PlateauLight {
-            position: scene_light.position,
-            radius: scene_light.radius,
-            size,
-            cone_segments: CONE_SEGMENTS,
-        };
+        let (position, radius) = nearer_light(frame);
+        let light = PlateauLight { position, radius, size, cone_segments: CONE_SEGMENTS };
         self.build_sides(frame, &plane, light, params.get(&EDGES));
         let mut geometry = PlateauGeometry::default();
         self.sides.iter().flatten().for_each(|(_, g)| geometry.extend(g));

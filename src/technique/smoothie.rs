@@ -207,7 +207,9 @@ impl Technique for Smoothie {
         let smoothie_size = if t > 0.0 {
             SmoothieSize::Fixed(t)
         } else {
-            SmoothieSize::Physical { light_radius: frame.scene.light.radius, scale: params.get(&T_SCALE) as f32 }
+            // The light as seen from the projection centre, which may be nearer than the light's.
+            let light_radius = frame.scene.light.radius * frustum.light_scale;
+            SmoothieSize::Physical { light_radius, scale: params.get(&T_SCALE) as f32 }
         };
         // Smoothies reach t beyond the casters' outline: the map and buffer must cover them.
         let frustum = frustum.grown(smoothie_size.largest_reach(frustum.near, frustum.far));
@@ -222,7 +224,8 @@ impl Technique for Smoothie {
         let buffer_size = params.get(&SMOOTHIE_SIZE) as u32;
         // The ground's height (none: infinitely far below) and the light's, for r in pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
-        let light_y = frame.scene.light.position.y;
+        // The projection centre's: a far light's is moved closer (LightFrustum::light_scale).
+        let light_y = frustum.centre().y;
         let kernel = Vec4::new(buffer_size as f32, 0.0, ground, light_y);
         self.pass.record(frame, &frustum, size, DEFAULT_BIASES, kernel)?;
 
