@@ -22,7 +22,7 @@ use glam::Vec4;
 
 use super::knobs::{Knob, Params};
 use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
-use super::{Technique, clear_visibility, ground, resolve, surface_inputs};
+use super::{Technique, clear_visibility, ground, nearer_light, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::{BlobData, ClassicView};
@@ -79,7 +79,7 @@ impl Technique for Blobs {
             return clear_visibility(frame, visibility); // no ground: no spot to draw
         };
         let plane = ReceiverPlane::ground(g.height);
-        let light = frame.scene.light.position;
+        let (light, _) = nearer_light(frame);
         let blobs: Vec<BlobData> = frame
             .draws
             .iter()
@@ -102,7 +102,7 @@ impl Technique for Blobs {
         }
         let ctx = frame.ctx;
         let params = Vec4::new(blobs.len() as f32, params.get(&SOFTNESS) as f32, 0.0, 0.0);
-        let view = ground::view(&plane, plane.height(light), Vec4::ZERO, params);
+        let view = ground::view(&plane, ground::on_plane_tolerance(frame, plane.height(light)), Vec4::ZERO, params);
         self.view.write(frame.slot, bytes_of(&view));
         let bytes: &[u8] = cast_slice(&blobs);
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
