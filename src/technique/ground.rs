@@ -7,27 +7,11 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::ClassicView;
 use crate::geometry::plateau::ReceiverPlane;
 
-/// f32 roundings the rasterized ground's surface may be off its plane by, in units of the
-/// largest coordinate its depths come from (its corners, the camera): 2^-23 each, a few of them.
-const GROUND_ROUNDING: f32 = 8.0 * 1.1920929e-7;
-
-/// How far off the receiver plane a surface of the camera prepass may be and still be on it,
-/// for a light `light_height` above the plane: a thousandth of that, and at least the rounding
-/// of the rasterized ground, whose depths near the camera are interpolated from corners
-/// `half_size` away. A ground of half size 8.6e4 m came out millimetres off its plane there,
-/// and every plane technique (blob, concentric, planar, plateau) lost the whole shadow
-/// (issue 19).
-pub(crate) fn on_plane_tolerance(frame: &FrameInputs<'_>, light_height: f32) -> f32 {
-    let ground = frame.scene.ground.map_or(0.0, |g| g.half_size + g.height.abs());
-    let reach = ground.max(frame.camera.position.abs().max_element());
-    (1e-3 * light_height.abs()).max(GROUND_ROUNDING * reach)
-}
-
-/// The plane's frame for the resolves; a surface within `tolerance` of the plane is on it
-/// ([`on_plane_tolerance`]).
-pub(crate) fn view(plane: &ReceiverPlane, tolerance: f32, window: Vec4, params: Vec4) -> ClassicView {
+/// The plane's frame for the resolves; a surface within 1e-3 of the light's height of the
+/// plane is on it (as the plateau's resolve takes it).
+pub(crate) fn view(plane: &ReceiverPlane, light_height: f32, window: Vec4, params: Vec4) -> ClassicView {
     ClassicView {
-        plane_origin: plane.origin.extend(tolerance),
+        plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
         plane_normal: plane.normal.extend(0.0),
         plane_u: plane.u.extend(0.0),
         plane_v: plane.v.extend(0.0),

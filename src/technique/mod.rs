@@ -85,15 +85,14 @@ pub(crate) fn refuse_wide_lights(scene: &crate::scene::Scene, technique: &str, m
 }
 
 /// The frame's light, taken nearer along its direction when it is farther than f32 resolves
-/// the casters and the receivers in view from (`geometry::nearer_light`): the position and
+/// the receivers in view and the casters that can shadow them from (`geometry::nearer_light`): the position and
 /// radius of the light of the same direction and angular size. For the techniques that
 /// project from the light themselves (Blinn's matrix from a light 1e8 m away lost a cube's
 /// whole shadow, issue 19).
 pub(crate) fn nearer_light(frame: &FrameInputs<'_>) -> (glam::Vec3, f32) {
-    let seen = crate::geometry::Aabb::from_points(frame.receivers_in_view.iter().copied());
-    let scene = frame.draws.iter().filter(|d| d.casts).fold(seen, |b, d| b.union(&d.bounds));
+    let casters = shadow_map::caster_bounds(frame);
     let light = &frame.scene.light;
-    crate::geometry::nearer_light(light.position, light.radius, &scene)
+    crate::geometry::nearer_light(light.position, light.radius, &casters, frame.receivers_in_view)
 }
 
 /// The first inputs of every resolve that reads the camera's surfaces, in binding order: the

@@ -102,7 +102,8 @@ impl Technique for Planar {
                 transform: frame.camera.view_proj * plane.blinn_matrix(q),
                 light: q.extend(1.0),
                 plane: equation,
-                tolerance: Vec4::new(super::ground::on_plane_tolerance(frame, plane.height(q)), 0.0, 0.0, 0.0),
+                // As the plateau's resolve: a thousandth of the light's height.
+                tolerance: Vec4::new(1e-3 * plane.height(q).abs(), 0.0, 0.0, 0.0),
                 normal,
                 pad: [Vec4::ZERO; 8],
             })

@@ -274,7 +274,7 @@ impl Technique for Plateau {
         let light_height = plane.height(light.position);
         let view = PlateauView {
             umbra: to_clip * plane.shadow_matrix(light.position),
-            plane_origin: plane.origin.extend(super::ground::on_plane_tolerance(frame, light_height)),
+            plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
             plane_normal: plane.normal.extend(0.0),
             plane_u: plane.u.extend(0.0),
             plane_v: plane.v.extend(0.0),
