@@ -3,8 +3,8 @@
 //! property test over scene scale, light radius, light distance and object spread that
 //! iterates the registry.
 //!
-//! The property test runs 16 cases by default (about 20 s on two cores) and [`FOUND`], the
-//! cases longer runs found, every time; a longer run (200 cases: about 4 minutes):
+//! The property test runs 32 cases by default (about 15 s on two cores) and [`FOUND`], the
+//! cases longer runs found, every time; a longer run (200 cases: about 100 s):
 //! `PROPTEST_CASES=200 cargo test --test truths every_technique`.
 
 mod common;
@@ -355,7 +355,7 @@ fn the_cases_the_property_found_stay_sound() {
 fn every_technique_is_sound_across_the_accepted_numbers() {
     let cases_env = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok());
     let config =
-        Config { cases: cases_env.unwrap_or(16), max_shrink_iters: 16, failure_persistence: None, ..Config::default() };
+        Config { cases: cases_env.unwrap_or(32), max_shrink_iters: 16, failure_persistence: None, ..Config::default() };
     let e = std::cell::RefCell::new(engine());
     e.borrow_mut().set_raw_visibility(true).unwrap();
     // The same cases every run by default; PROPTEST_CASES explores further from the same seed.
