@@ -48,7 +48,8 @@ float in_front_of_itself(Surface s, vec3 c, float radius) {
     vec3 to_light = c - s.p;
     float dist = length(to_light);
     float h = clamp(dot(s.n, to_light) / max(radius, 1e-6 * dist), -1.0, 1.0);
-    return 1.0 - (acos(h) - h * sqrt(1.0 - h * h)) / 3.14159265;
+    // Clamped: near h = ±1 the two terms cancel and their rounding left V at 1.0000001 (issue 19).
+    return clamp(1.0 - (acos(h) - h * sqrt(1.0 - h * h)) / 3.14159265, 0.0, 1.0);
 }
 
 #endif

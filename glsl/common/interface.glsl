@@ -19,7 +19,8 @@ struct FrameGlobals {
 // One per drawn object, indexed by gl_InstanceIndex (the draw's firstInstance).
 struct ObjectData {
     mat4 model;          // object -> world
-    mat4 normal_matrix;  // inverse transpose of the model's 3x3, in the upper left
+    mat4 normal_matrix;  // inverse transpose of the model's 3x3, in the upper left; column 3:
+                         // an exact plane's equation (n, -n.o) (the ground), else (0, 0, 0, 1)
     vec4 albedo;         // rgb linear albedo; a = shadow role: 0 no shadows, 0.5 receives, 1 receives + casts
 };
 

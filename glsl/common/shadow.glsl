@@ -5,6 +5,27 @@
 #define SOFTSHADOW_SHADOW_GLSL
 #include "interface.glsl"
 
+// Linear light depths are f32 sums of terms as large as the depth, the point's coordinates
+// and the view's translation, computed on both sides (the map's rasterized depth, the
+// receiver's rebuilt and transformed point) with a few roundings each: they disagree by a
+// few ulps (2^-23) of the largest term however small a texel is. A tiny caster under a far
+// light (a 1 mm cube 25 m away: texel 6e-7 m, ulp 2e-6 m) has texel biases far below that
+// and shadows its own lit faces.
+const float DEPTH_ROUNDING = 8.0 * 1.1920929e-7;
+
+// The world distance the depths of a receiver at `p`, light depth `z`, may round by.
+float depth_rounding(LightView light, vec3 p, float z) {
+    return DEPTH_ROUNDING * max(abs(z), max(length(p), length(light.view[3].xyz)));
+}
+
+// The radius of the light `radius` wide at `from` as seen from the projection centre of
+// `light`, where a far light is moved to (LightFrustum::light_scale, src/geometry): the one that
+// spans the same angle from the receiver p, for similar triangles in light depths.
+float apparent_radius(LightView light, vec3 from, vec3 p, float radius) {
+    vec3 origin = -(transpose(mat3(light.view)) * light.view[3].xyz);
+    return radius * distance(p, origin) / max(distance(p, from), 1e-30);
+}
+
 // Where a receiver point falls in a light's map.
 struct ShadowLookup {
     vec2 uv;      // in the map, 0..1 (row 0 at v = 0)
@@ -24,7 +45,7 @@ ShadowLookup shadow_lookup(LightView light, vec3 from, vec3 p, vec3 n) {
     // Normal offset grows as the surface turns from the light, where acne starts.
     vec3 q = p + n * (light.bias.z * texel * (1.0 - cos_theta));
     float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / max(cos_theta, 1e-3), 8.0);
-    float bias = texel * (light.bias.x + light.bias.y * tan_theta);
+    float bias = texel * (light.bias.x + light.bias.y * tan_theta) + depth_rounding(light, p, z);
 
     vec4 clip = light.view_proj * vec4(q, 1.0);
     s.inside = clip.w > 0.0;
@@ -68,7 +89,8 @@ ReceiverPlane receiver_plane(LightView light, vec3 p, vec3 n) {
     r.n = mat3(light.view) * n; // the view is rigid
     if (dot(r.n, r.p) > 0.0) r.n = -r.n;
     // The constant depth bias (texels at the receiver): the depth map's own rounding.
-    r.margin = light.bias.x * r.p.z * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
+    r.margin = light.bias.x * r.p.z * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w
+             + depth_rounding(light, p, r.p.z);
     return r;
 }
 

@@ -10,6 +10,7 @@ layout(location = 1) in vec3 in_normal;
 layout(location = 0) out vec3 out_normal;
 layout(location = 1) flat out vec4 out_albedo;
 layout(location = 2) out vec3 out_world;
+layout(location = 3) flat out vec4 out_plane;
 
 void main() {
     ObjectData object = objects[gl_InstanceIndex];
@@ -19,6 +20,7 @@ void main() {
     out_normal = mat3(object.normal_matrix) * in_normal;
     out_albedo = object.albedo;
     out_world = world.xyz;
+    out_plane = object.normal_matrix[3];
     precise vec4 position = frame.view_proj * world;
     gl_Position = position;
 }

@@ -55,6 +55,7 @@ void main() {
         // The receiver-plane tests of pcss() leave a caster's own surface out of the map, so the
         // part of the light below its tangent plane is taken out here (the soft hides_itself).
         float self_lit = in_front_of_itself(s, frame.light.xyz, light.kernel.y);
-        out_visibility = self_lit * pcss(shadow_map, light, l, s.p, s.n);
+        float radius = apparent_radius(light, frame.light.xyz, s.p, light.kernel.y);
+        out_visibility = self_lit * pcss(shadow_map, light, l, s.p, s.n, radius);
     }
 }

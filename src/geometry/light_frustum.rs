@@ -36,6 +36,12 @@ pub struct LightFrustum {
     pub window: [f32; 4],
     pub near: f32,
     pub far: f32,
+    /// The projection centre's distance from the scene over the light's: 1, or less where a far
+    /// light was moved closer. Techniques that size penumbrae from light depths by similar
+    /// triangles (smoothies' t = R / b) take the light's radius times this, the light of the
+    /// same angular size at the projection centre; a 5e5 m sun 1e8 m away seen from 5 km with
+    /// its own radius would span 90° instead of 0.3°.
+    pub light_scale: f32,
 }
 
 /// What [`fit_spot_frustum`] found.
@@ -72,8 +78,8 @@ pub fn fit_spot_frustum(light: Vec3, hint: Option<Vec3>, casters: &[Aabb], recei
     let centre = (smin + smax) * 0.5;
     let extent = (smax - smin).length().max(f64::MIN_POSITIVE);
     let distance = (l - centre).length();
-    let origin =
-        if distance > MAX_RANGE * extent { centre + (l - centre) * (MAX_RANGE * extent / distance) } else { l };
+    let light_scale = nearer_light_scale(distance, extent);
+    let origin = centre + (l - centre) * light_scale;
 
     // Start from the hint and from the casters' mean direction; keep the narrower window.
     let mean = boxes.iter().flatten().filter_map(|c| (*c - origin).try_normalize()).sum::<DVec3>();
@@ -119,7 +125,33 @@ pub fn fit_spot_frustum(light: Vec3, hint: Option<Vec3>, casters: &[Aabb], recei
     // The depth range reaches the receivers too: `far` is then the farthest receiver, which
     // bounds how far a smoothie can matter; depth is linear in the colour target anyway.
     let far = receivers.iter().map(|p| frame.view.transform_point3(*p).z).fold(far, f64::max) * 1.001;
-    SpotFit { frustum: Some(frustum(frame.view, w, near, far)), clipped }
+    SpotFit { frustum: Some(frustum(frame.view, w, near, far, light_scale as f32)), clipped }
+}
+
+/// How much nearer a light `distance` from the centre of a scene `extent` wide is taken, along
+/// its own direction, for f32 to resolve the scene in its depths or projections ([`MAX_RANGE`]):
+/// 1, or the factor that brings it to `MAX_RANGE` extents. Its radius scales by the same, which
+/// keeps the light's angular size from the scene.
+pub fn nearer_light_scale(distance: f64, extent: f64) -> f64 {
+    (MAX_RANGE * extent / distance).min(1.0)
+}
+
+/// A light at `light` of `radius`, taken nearer for f32 projections ([`nearer_light_scale`])
+/// to the scene that matters: the `receivers` in view and the `casters` (world boxes) that can
+/// shadow them (a ball 53 km off kept a light 2e6 m away where a 1.7 cm cube lost its shadow).
+/// The position and radius of the light of the same direction and angular size from there.
+pub fn nearer_light(light: Vec3, radius: f32, casters: &[Aabb], receivers: &[Vec3]) -> (Vec3, f32) {
+    let l = light.as_dvec3();
+    let seen = Aabb::from_points(receivers.iter().copied());
+    let (rmin, rmax) = (seen.min.as_dvec3(), seen.max.as_dvec3());
+    let scene = casters.iter().filter(|c| can_shadow(l, c, rmin, rmax)).fold(seen, |b, c| b.union(c));
+    if scene.is_empty() {
+        return (light, radius);
+    }
+    let centre = scene.center().as_dvec3();
+    let extent = (scene.max - scene.min).as_dvec3().length().max(f64::MIN_POSITIVE);
+    let k = nearer_light_scale((l - centre).length(), extent);
+    ((centre + (l - centre) * k).as_vec3(), (f64::from(radius) * k) as f32)
 }
 
 /// Whether the box meets the hull of `light` and the box `rmin`..`rmax`: some t ≥ 1 scales
@@ -204,7 +236,7 @@ fn look_along(origin: DVec3, z_axis: DVec3) -> DMat4 {
     )
 }
 
-fn frustum(view: DMat4, w: [f64; 4], near: f64, far: f64) -> LightFrustum {
+fn frustum(view: DMat4, w: [f64; 4], near: f64, far: f64, light_scale: f32) -> LightFrustum {
     let (sx, sy) = (w[2] - w[0], w[3] - w[1]);
     let depth_scale = far / (far - near);
     let proj = DMat4::from_cols(
@@ -219,17 +251,24 @@ fn frustum(view: DMat4, w: [f64; 4], near: f64, far: f64) -> LightFrustum {
         window: w.map(|v| v as f32),
         near: near as f32,
         far: far as f32,
+        light_scale,
     }
 }
 
 impl LightFrustum {
+    /// The projection centre in world space: the light's centre, or the point a far light was
+    /// moved to along its direction (`light_scale` < 1). Depths are distances from it.
+    pub fn centre(&self) -> Vec3 {
+        self.view.inverse().transform_point3(Vec3::ZERO)
+    }
+
     /// The same frustum with its window grown by `pad` tangent units on every side (geometry
     /// drawn around the casters, such as smoothies), still within ±tan 80°.
     pub fn grown(&self, pad: f32) -> LightFrustum {
         let [x0, y0, x1, y1] = self.window.map(f64::from);
         let pad = f64::from(pad);
         let w = [(x0 - pad).max(-MAX_TAN), (y0 - pad).max(-MAX_TAN), (x1 + pad).min(MAX_TAN), (y1 + pad).min(MAX_TAN)];
-        frustum(self.view.as_dmat4(), w, f64::from(self.near), f64::from(self.far))
+        frustum(self.view.as_dmat4(), w, f64::from(self.near), f64::from(self.far), self.light_scale)
     }
 }
 
@@ -326,6 +365,9 @@ mod tests {
         // Its rays keep the light's direction.
         let axis = f.view.inverse().transform_vector3(Vec3::Z);
         assert!(axis.dot(-light.normalize()) > 0.99, "{axis}");
+        // A light's radius times light_scale spans the same angle from the scene at the centre.
+        let ratio = (f.centre() - caster.center()).length() / (light - caster.center()).length();
+        assert!((f.light_scale / ratio - 1.0).abs() < 0.01, "scale {} for {ratio}", f.light_scale);
         // A caster's top is nearer than the ground below it, by more than the f32 depth ulp.
         let z = |p: Vec3| (f.view * p.extend(1.0)).z;
         assert!(z(Vec3::ZERO) - z(Vec3::Y) > 0.5, "{} {}", z(Vec3::ZERO), z(Vec3::Y));

@@ -22,7 +22,7 @@ use glam::Vec4;
 
 use super::knobs::{Knob, Params};
 use super::registry::{Kind, Receivers, SweepKnobs, TechniqueInfo};
-use super::{Technique, clear_visibility, ground, resolve, surface_inputs};
+use super::{Technique, clear_visibility, ground, nearer_light, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::{BlobData, ClassicView};
@@ -79,7 +79,7 @@ impl Technique for Blobs {
             return clear_visibility(frame, visibility); // no ground: no spot to draw
         };
         let plane = ReceiverPlane::ground(g.height);
-        let light = frame.scene.light.position;
+        let (light, _) = nearer_light(frame);
         let blobs: Vec<BlobData> = frame
             .draws
             .iter()

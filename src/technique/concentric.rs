@@ -34,7 +34,7 @@ use glam::{Mat4, Vec2, Vec4};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map::draw_casters;
-use super::{Technique, clear_visibility, ground, resolve, surface_inputs};
+use super::{Technique, clear_visibility, ground, nearer_light, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::ClassicView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -133,7 +133,7 @@ impl Technique for Concentric {
         };
         let ctx = frame.ctx;
         let plane = ReceiverPlane::ground(g.height);
-        let (light, radius) = (frame.scene.light.position, frame.scene.light.radius);
+        let (light, radius) = nearer_light(frame);
         let hl = plane.height(light);
         let n = params.get(&PROJECTIONS) as u32;
         let scale = params.get(&SPREAD_SCALE) as f32;

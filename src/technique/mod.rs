@@ -85,6 +85,17 @@ pub(crate) fn refuse_wide_lights(scene: &crate::scene::Scene, technique: &str, m
     Ok(())
 }
 
+/// The frame's light, taken nearer along its direction when it is farther than f32 resolves
+/// the receivers in view and the casters that can shadow them from (`geometry::nearer_light`): the position and
+/// radius of the light of the same direction and angular size. For the techniques that
+/// project from the light themselves (Blinn's matrix from a light 1e8 m away lost a cube's
+/// whole shadow, issue 19).
+pub(crate) fn nearer_light(frame: &FrameInputs<'_>) -> (glam::Vec3, f32) {
+    let casters = shadow_map::caster_bounds(frame);
+    let light = &frame.scene.light;
+    crate::geometry::nearer_light(light.position, light.radius, &casters, frame.receivers_in_view)
+}
+
 /// The first inputs of every resolve that reads the camera's surfaces, in binding order: the
 /// frame's globals, the technique's `light` (view) buffer, camera depth, camera normal.
 pub(crate) fn surface_inputs<'a>(

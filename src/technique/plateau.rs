@@ -46,7 +46,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::{Technique, clear_visibility, refuse_wide_lights, resolve, surface_inputs};
+use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -272,7 +272,6 @@ impl Technique for Plateau {
         };
         let ctx = frame.ctx;
         let plane = ReceiverPlane::ground(ground.height);
-        let scene_light = &frame.scene.light;
         refuse_wide_lights(
             frame.scene,
             "plateau",
@@ -285,9 +284,10 @@ impl Technique for Plateau {
             PenumbraSize::Physical { scale: params.get(&PENUMBRA_SCALE) as f32 }
         };
         let centred = params.is_on(&CENTRED);
+        let (position, radius) = nearer_light(frame);
         let light = PlateauLight {
-            position: scene_light.position,
-            radius: scene_light.radius,
+            position,
+            radius,
             size,
             penumbra: if centred { Penumbra::Centred } else { Penumbra::Outer },
             cone_segments: CONE_SEGMENTS,

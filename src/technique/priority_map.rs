@@ -33,7 +33,7 @@ use super::knobs::{Knob, Params};
 use super::object_ids::ObjectIds;
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
 use super::shadow_map::ShadowMapPass;
-use super::{Technique, clear_visibility, resolve, surface_inputs};
+use super::{Technique, clear_visibility, nearer_light, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::LightView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -112,7 +112,8 @@ impl Technique for PriorityMap {
         let ctx = frame.ctx;
         let size = params.get(&MAP_SIZE) as u32;
         // The DDJ's sort: casters by distance from the light, nearest first, ranked from 0.
-        let l = frame.scene.light.position;
+        // From a far light taken nearer: f32 distances 1e8 m away tie casters metres apart.
+        let (l, _) = nearer_light(frame);
         let mut casters: Vec<_> = frame.draws.iter().filter(|d| d.casts).collect();
         casters.sort_by(|a, b| a.bounds.center().distance(l).total_cmp(&b.bounds.center().distance(l)));
         let instances = frame.draws.iter().map(|d| d.instance as usize + 1).max().unwrap_or(0);

@@ -38,7 +38,7 @@ use glam::{Vec3, Vec4};
 use super::knobs::{Knob, Params};
 use super::object_ids::ObjectIds;
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
-use super::{Technique, clear_visibility, resolve, surface_inputs};
+use super::{Technique, clear_visibility, nearer_light, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::{CasterImage, ClassicView};
 use crate::frame::{FrameInputs, MESH_POSITIONS};
@@ -119,7 +119,10 @@ impl ProjectiveTexture {
 
 impl Technique for ProjectiveTexture {
     fn record(&mut self, frame: &mut FrameInputs<'_>, params: &Params, visibility: &mut Target) -> Result<()> {
-        let light = frame.scene.light.position;
+        // The images are projected from a far light taken nearer (f32 lost a cube's image from
+        // 5.8e7 m, issue 19); `to_light` in the resolve stays the true distance.
+        let (light, _) = nearer_light(frame);
+        let farther = |p: Vec3| p.distance(frame.scene.light.position) - p.distance(light);
         // Each caster's bounding sphere, from its own box turned with it, and its up axis.
         let views: Vec<_> = frame
             .draws
@@ -135,7 +138,7 @@ impl Technique for ProjectiveTexture {
                 };
                 let centre = corners.iter().sum::<Vec3>() / 8.0;
                 let radius = corners.iter().map(|c| c.distance(centre)).fold(0.0, f32::max);
-                caster_view(light, centre, radius, up).map(|v| (d, v))
+                caster_view(light, centre, radius, up).map(|v| (d, v, farther(centre)))
             })
             .collect();
         if views.is_empty() || frame.receivers_in_view.is_empty() {
@@ -148,13 +151,13 @@ impl Technique for ProjectiveTexture {
         let images: Vec<CasterImage> = views
             .iter()
             .enumerate()
-            .map(|(i, (d, v))| {
+            .map(|(i, (d, v, farther))| {
                 let (x, y) = ((i as u32 % grid) as f32, (i as u32 / grid) as f32);
                 let t = 1.0 / grid as f32;
                 CasterImage {
                     view_proj: v.view_proj,
                     tile: Vec4::new(x * t, y * t, t, t),
-                    info: Vec4::new(v.near, d.instance as f32, 0.0, 0.0),
+                    info: Vec4::new(v.near + farther, d.instance as f32, 0.0, 0.0),
                     pad: [Vec4::ZERO; 10],
                 }
             })
@@ -174,7 +177,7 @@ impl Technique for ProjectiveTexture {
         frame.timer.begin(ctx, cmd, "images");
         transition(ctx, cmd, &mut [(atlas, Access::COLOR_WRITE, true)]);
         let pass = RenderPass::begin(ctx, cmd, &[Attachment::clear_color(atlas, [1.0; 4])], None);
-        for (i, (d, _)) in views.iter().enumerate() {
+        for (i, (d, _, _)) in views.iter().enumerate() {
             let i = i as u32;
             let offset = vk::Offset2D { x: ((i % grid) * tile) as i32, y: ((i / grid) * tile) as i32 };
             pass.set_area(ctx, cmd, vk::Rect2D { offset, extent: vk::Extent2D { width: tile, height: tile } });

@@ -263,8 +263,8 @@ impl Technique for Smoothie {
         // The ground's height (none: infinitely far below) and the light view origin's, for r in
         // pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
-        // The view's origin, not the light: the fit moves it closer for a far light.
-        let light_y = frustum.view.inverse().w_axis.y;
+        // The projection centre's: the fit moves a far light closer (LightFrustum::centre).
+        let light_y = frustum.centre().y;
         // What an empty map texel reads: the clear depth, which a 16-bit map saturates.
         let empty = if format == DEPTH_FORMAT { EMPTY_DEPTH } else { HALF_MAX };
         let kernel = Vec4::new(buffer_size as f32, empty, ground, light_y);
