@@ -10,7 +10,8 @@ use serde::Deserialize;
 
 use super::read::{MAX_SCENE_BYTES, clip_lines, read_limited};
 use super::{
-    Camera, Ground, KnobSetting, Light, MAX_COORDINATE, MAX_TRIANGLES, Mesh, Object, RenderSettings, Scene, Transform, primitives,
+    Camera, Ground, KnobSetting, Light, MAX_COORDINATE, MAX_TRIANGLES, Mesh, Object, RenderSettings, Scene, Transform,
+    primitives,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Projection;

@@ -15,6 +15,7 @@ pub mod projective_texture;
 pub mod reference;
 pub mod registry;
 pub mod shadow_map;
+pub mod shadow_mesh;
 pub mod shadow_volume;
 pub mod smoothie;
 mod smoothie_gpu;
