@@ -115,6 +115,9 @@ struct BenchArgs {
     /// A small subset (two scenes, default settings, 128²) for CI.
     #[arg(long)]
     quick: bool,
+    /// Also the scale scenes of scenes/scale/ (60k–100k triangles; minutes more on lavapipe).
+    #[arg(long, conflicts_with_all = ["scenes", "quick"])]
+    scale: bool,
     /// Frames timed per setting, after warm-up.
     #[arg(long, default_value_t = 20)]
     frames: usize,
@@ -128,6 +131,11 @@ struct BenchArgs {
     /// written to DIR/extremes.csv; fails if any check fails.
     #[arg(long, conflicts_with_all = ["scenes", "quick", "trace"])]
     extremes: bool,
+    /// Instead of the trade: each technique's cost against triangle count, at these sizes of
+    /// the scene's knots (the scene given, else scenes/scale/knot.toml), written to
+    /// DIR/curve.csv, curve.md (slopes) and cost_curve.png.
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["quick", "extremes", "trace"])]
+    curve: Vec<u32>,
 }
 
 #[derive(clap::Parser)]
@@ -478,10 +486,56 @@ fn extremes(args: &BenchArgs) -> Result<()> {
     Ok(())
 }
 
+/// `bench --curve`: every benched technique's defaults on the scene's knots re-made at each size.
+fn curve(args: &BenchArgs) -> Result<()> {
+    use softshadow::measure::bench::sweep;
+    use softshadow::measure::curve::{CurvePoint, write_curve};
+    let path = match args.scenes.as_slice() {
+        [] => Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/scale/knot.toml"),
+        [one] => one.clone(),
+        _ => bail!("--curve takes one scene"),
+    };
+    let what = SceneArgs { scene: path, technique: None, set: Vec::new(), width: None, height: None, frames: None };
+    let (base, _) = load(&what)?;
+    if !base.objects.iter().any(|o| o.mesh.name == "knot") {
+        bail!("--curve needs a scene with a `shape = \"knot\"` object to re-make at each size");
+    }
+    for t in &args.techniques {
+        find(t)?;
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let mut engine = Engine::headless(&ContextOptions::from_env())?;
+    let mut points = Vec::new();
+    for &n in &args.curve {
+        let mut scene = base.clone();
+        let knot = std::sync::Arc::new(softshadow::scene::primitives::knot(n)?);
+        scene.objects.iter_mut().filter(|o| o.mesh.name == "knot").for_each(|o| o.mesh = knot.clone());
+        let triangles = scene.objects.iter().filter(|o| o.casts).map(|o| o.mesh.triangles.len()).sum();
+        for (info, sets) in sweep(true) {
+            if !(args.techniques.is_empty() || args.techniques.iter().any(|t| t == info.name)) {
+                continue;
+            }
+            let mut settings = FrameSettings::from_scene(&scene)?;
+            settings.params = Params::defaults(info);
+            settings.params.apply(sets.iter().copied())?;
+            let (_, timings) = render_frames(&mut engine, &scene, &settings, Some(args.frames), None)?;
+            println!("{triangles} triangles, {}: {:.2} ms", info.name, timings.gpu_ms_total_median);
+            points.push(CurvePoint { technique: info.name.into(), triangles, gpu_ms: timings.gpu_ms_total_median });
+        }
+    }
+    finish(engine)?;
+    write_curve(&points, softshadow::technique::shadow_map::INFO.name, &args.out)?;
+    println!("wrote {0}/curve.csv, {0}/curve.md, {0}/cost_curve.png", args.out.display());
+    Ok(())
+}
+
 /// `bench`: the sweep of measure::bench over the scene suite.
 fn bench(args: &BenchArgs) -> Result<()> {
     if args.extremes {
         return extremes(args);
+    }
+    if !args.curve.is_empty() {
+        return curve(args);
     }
     use softshadow::measure::bench::{
         BenchRow, load_reference, mark_pareto, registry_cost_goals, save_reference, setting_label, sweep, write_csv,
@@ -493,12 +547,17 @@ fn bench(args: &BenchArgs) -> Result<()> {
     } else if args.quick {
         vec![suite.join("plate.toml"), suite.join("sphere.toml")]
     } else {
-        let mut all: Vec<PathBuf> = std::fs::read_dir(&suite)
-            .with_context(|| format!("listing {}", suite.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-            .collect();
-        all.sort();
+        let folders = if args.scale { vec![suite.clone(), suite.join("scale")] } else { vec![suite.clone()] };
+        let mut all = Vec::new();
+        for folder in folders {
+            let mut of: Vec<PathBuf> = std::fs::read_dir(&folder)
+                .with_context(|| format!("listing {}", folder.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect();
+            of.sort();
+            all.extend(of);
+        }
         all
     };
     for t in &args.techniques {

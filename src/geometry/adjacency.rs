@@ -29,6 +29,9 @@ pub struct EdgeAdjacency {
     /// Manifold and boundary edges. A non-manifold edge appears once per incident face, as a
     /// boundary edge of that face, so that silhouette tests stay conservative.
     pub edges: Vec<Edge>,
+    /// `edges[i].faces`, apart: what silhouette extraction streams through every frame, half
+    /// the bytes of `edges`.
+    pub face_pairs: Vec<[u32; 2]>,
     /// Edges with exactly one face.
     pub boundary: usize,
     /// Edges with three or more faces.
@@ -67,6 +70,7 @@ impl EdgeAdjacency {
                 }
             }
         }
+        adjacency.face_pairs = adjacency.edges.iter().map(|e| e.faces).collect();
         adjacency
     }
 

@@ -89,3 +89,42 @@ pub fn cylinder(radius: f32, height: f32) -> Shape {
     }
     (p, tris)
 }
+
+/// A (2, 3) torus knot (a trefoil) tube of about `triangles` triangles, fitting in the unit
+/// sphere: one closed genus-1 surface whose triangle count is a free parameter, for measuring
+/// cost against mesh size. Rings along the knot outnumber the segments around the tube 8:1 so
+/// the quads stay near square.
+pub fn torus_knot(triangles: u32) -> Shape {
+    const TUBE: f32 = 0.4;
+    const EXTENT: f32 = 3.0 + TUBE; // the centre line's largest radius plus the tube's
+    let around = ((triangles as f32 / 16.0).sqrt().round() as u32).max(3);
+    let along = (triangles / (2 * around)).max(3);
+    let centre = |t: f32| {
+        let r = 2.0 + (3.0 * t).cos();
+        Vec3::new(r * (2.0 * t).cos(), (3.0 * t).sin(), r * (2.0 * t).sin())
+    };
+    let mut p = Vec::with_capacity((along * around) as usize);
+    for i in 0..along {
+        let t = TAU * i as f32 / along as f32;
+        // Frenet frame from central differences: the trefoil's curvature never vanishes.
+        let h = 1e-3;
+        let (before, at, after) = (centre(t - h), centre(t), centre(t + h));
+        let tangent = (after - before).normalize();
+        let normal = (after - 2.0 * at + before).reject_from(tangent).normalize();
+        let binormal = tangent.cross(normal);
+        for j in 0..around {
+            let phi = TAU * j as f32 / around as f32;
+            p.push((at + TUBE * (phi.cos() * normal + phi.sin() * binormal)) / EXTENT);
+        }
+    }
+    let at = |i: u32, j: u32| (i % along) * around + j % around;
+    let mut tris = Vec::with_capacity(2 * (along * around) as usize);
+    for i in 0..along {
+        for j in 0..around {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            tris.push([a, c, b]);
+            tris.push([a, d, c]);
+        }
+    }
+    (p, tris)
+}

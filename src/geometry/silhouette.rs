@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::adjacency::{EdgeAdjacency, NO_FACE};
+use super::adjacency::EdgeAdjacency;
 
 /// A caster as silhouette extraction sees it.
 pub struct Caster<'a> {
@@ -24,14 +24,16 @@ pub enum EdgeSource {
     LightFacing,
 }
 
-/// Which triangles face the light: computed once per face per frame.
+/// Which triangles face the light: computed once per face per frame. The plane test uses a
+/// corner rather than the centroid (the same plane, three fewer additions per face).
 pub fn light_facing(caster: &Caster<'_>, light: Vec3) -> Vec<bool> {
+    let p = caster.positions;
     caster
         .triangles
         .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| caster.positions[i as usize]);
-            (b - a).cross(c - a).dot(light - (a + b + c) / 3.0) > 0.0
+        .map(|&[a, b, c]| {
+            let a = p[a as usize];
+            (p[b as usize] - a).cross(p[c as usize] - a).dot(light - a) > 0.0
         })
         .collect()
 }
@@ -50,20 +52,19 @@ pub fn penumbra_edges(caster: &Caster<'_>, facing: &[bool], source: EdgeSource) 
             .filter(|(_, f)| **f)
             .flat_map(|(t, _)| [([t[0], t[1]], t[2]), ([t[1], t[2]], t[0]), ([t[2], t[0]], t[1])])
             .collect(),
-        EdgeSource::Silhouettes => caster
-            .adjacency
-            .edges
-            .iter()
-            .filter_map(|e| {
-                let lit = |f: u32| f != NO_FACE && facing[f as usize];
-                let [f0, f1] = e.faces;
-                match (lit(f0), lit(f1)) {
-                    (true, false) => Some((e.vertices, third(f0, e.vertices))),
-                    (false, true) => Some((e.vertices, third(f1, e.vertices))),
-                    _ => None,
-                }
-            })
-            .collect(),
+        // The faces alone, 8 bytes an edge, in one pass; the vertices only for the few
+        // silhouettes. A missing face (`NO_FACE`) is past the end of `facing`: unlit.
+        EdgeSource::Silhouettes => {
+            let lit = |f: u32| facing.get(f as usize).copied().unwrap_or(false);
+            let pairs = &caster.adjacency.face_pairs;
+            let crossing = pairs.iter().enumerate().filter(|(_, [f0, f1])| lit(*f0) != lit(*f1));
+            crossing
+                .map(|(i, &[f0, f1])| {
+                    let e = caster.adjacency.edges[i].vertices;
+                    (e, third(if lit(f0) { f0 } else { f1 }, e))
+                })
+                .collect()
+        }
     }
 }
 

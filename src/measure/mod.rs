@@ -2,6 +2,7 @@
 //! sweep and its plot, the default run's contact sheet, and timing traces.
 
 pub mod bench;
+pub mod curve;
 pub mod extremes;
 mod metrics;
 mod plot;

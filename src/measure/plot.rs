@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 /// Where Debian's fonts-dejavu-core puts the font (scripts/install-deps.sh installs it).
 const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-const COLORS: [RGBColor; 8] = [
+pub(super) const COLORS: [RGBColor; 12] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -21,6 +21,10 @@ const COLORS: [RGBColor; 8] = [
     RGBColor(140, 86, 75),
     RGBColor(227, 119, 194),
     RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(188, 189, 34),
+    RGBColor(0, 0, 128),
+    RGBColor(127, 127, 127),
 ];
 
 pub(super) fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {

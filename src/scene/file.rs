@@ -10,7 +10,8 @@ use serde::Deserialize;
 
 use super::read::{MAX_SCENE_BYTES, clip_lines, read_limited};
 use super::{
-    Camera, Ground, KnobSetting, Light, MAX_COORDINATE, Mesh, Object, RenderSettings, Scene, Transform, primitives,
+    Camera, Ground, KnobSetting, Light, MAX_COORDINATE, MAX_TRIANGLES, Mesh, Object, RenderSettings, Scene, Transform,
+    primitives,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Projection;
@@ -66,6 +67,9 @@ enum Shape {
     Cylinder,
     Plate,
     Mesh,
+    /// A trefoil knot tube of `triangles` triangles in the unit sphere: a mesh whose size is a
+    /// parameter, for cost against triangle count.
+    Knot,
 }
 
 #[derive(Deserialize)]
@@ -84,6 +88,7 @@ struct ObjectFile {
     radius: Option<f32>,
     height: Option<f32>,
     mesh: Option<String>,
+    triangles: Option<u32>,
     #[serde(default)]
     position: Triple,
     #[serde(default)]
@@ -130,6 +135,9 @@ struct RenderFile {
 }
 
 /// Albedos for objects that name no color: distinct, mid-bright, linear RGB.
+/// The fewest triangles a knot is made of: 3 segments around by 3 rings along, twice.
+const MIN_KNOT_TRIANGLES: u32 = 18;
+
 const PALETTE: [[f32; 3]; 6] = [
     [0.80, 0.30, 0.25],
     [0.25, 0.50, 0.80],
@@ -240,9 +248,10 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
         }
     };
     let (size, radius, height, mesh_key) = (o.size.is_some(), o.radius.is_some(), o.height.is_some(), o.mesh.is_some());
+    let triangles = o.triangles.is_some();
     let mesh = match o.shape {
         Shape::Box | Shape::Plate => {
-            unused(&[("radius", radius), ("height", height), ("mesh", mesh_key)])?;
+            unused(&[("radius", radius), ("height", height), ("mesh", mesh_key), ("triangles", triangles)])?;
             let s = Vec3::from(o.size.ok_or("needs `size = [x, y, z]`")?);
             // A plate may be infinitely thin; a box may not.
             let min_y = if o.shape == Shape::Plate { 0.0 } else { f32::MIN_POSITIVE };
@@ -254,17 +263,25 @@ fn object(o: &ObjectFile, index: usize, base: &Path) -> std::result::Result<Obje
             primitives::cuboid(s)
         }
         Shape::Sphere => {
-            unused(&[("size", size), ("height", height), ("mesh", mesh_key)])?;
+            unused(&[("size", size), ("height", height), ("mesh", mesh_key), ("triangles", triangles)])?;
             primitives::sphere(positive("radius", o.radius)?)
         }
         Shape::Cylinder => {
-            unused(&[("size", size), ("mesh", mesh_key)])?;
+            unused(&[("size", size), ("mesh", mesh_key), ("triangles", triangles)])?;
             primitives::cylinder(positive("radius", o.radius)?, positive("height", o.height)?)
         }
         Shape::Mesh => {
-            unused(&[("size", size), ("radius", radius), ("height", height)])?;
+            unused(&[("size", size), ("radius", radius), ("height", height), ("triangles", triangles)])?;
             let rel = o.mesh.as_ref().ok_or("needs `mesh = \"path.obj\"`")?;
             Mesh::load_obj(&base.join(rel))
+        }
+        Shape::Knot => {
+            unused(&[("size", size), ("radius", radius), ("height", height), ("mesh", mesh_key)])?;
+            let n = o.triangles.ok_or("needs `triangles = N`")?;
+            if !(MIN_KNOT_TRIANGLES..=MAX_TRIANGLES as u32).contains(&n) {
+                return Err(format!("`triangles` must lie in {MIN_KNOT_TRIANGLES}..={MAX_TRIANGLES}, got {n}"));
+            }
+            primitives::knot(n)
         }
     }
     .map_err(|e| e.to_string())?;

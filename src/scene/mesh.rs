@@ -3,6 +3,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
 
@@ -41,6 +42,8 @@ pub struct Mesh {
     /// Built once here; silhouettes walk it every frame.
     pub adjacency: EdgeAdjacency,
     pub bounds: Aabb,
+    /// Simplified copies made by [`Mesh::shadow_mesh`], by their error's power of two.
+    shadow_meshes: Mutex<Vec<(i32, Arc<Mesh>)>>,
 }
 
 impl Mesh {
@@ -80,7 +83,7 @@ impl Mesh {
         let adjacency = EdgeAdjacency::build(&triangles);
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let id = MeshId(NEXT.fetch_add(1, Ordering::Relaxed));
-        Ok(Mesh { id, name, positions, triangles, adjacency, bounds })
+        Ok(Mesh { id, name, positions, triangles, adjacency, bounds, shadow_meshes: Mutex::default() })
     }
 
     /// Loads every object of an OBJ file into one mesh (triangulated), within the limits of
@@ -115,6 +118,43 @@ impl Mesh {
 
     pub fn id(&self) -> MeshId {
         self.id
+    }
+
+    /// A simpler copy to cast shadows from, the DDJ's "separate shadowing and drawing models"
+    /// (shadow models "considerably simpler"): meshoptimizer's simplifier (quadric error,
+    /// borders locked so open meshes keep their outline) with every surface point within
+    /// `error` (object units) of this mesh. `error` is rounded down to a power of two, so a caster
+    /// moving closer or farther reuses a few cached copies. This mesh itself when `error` is not
+    /// positive or the simplifier removes nothing.
+    pub fn shadow_mesh(self: &Arc<Self>, error: f32) -> Arc<Mesh> {
+        if !(error > 0.0 && error.is_finite()) {
+            return self.clone();
+        }
+        let exponent = error.log2().floor() as i32;
+        let mut cache = self.shadow_meshes.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some((_, m)) = cache.iter().find(|(e, _)| *e == exponent) {
+            return m.clone();
+        }
+        let indices: Vec<u32> = self.triangles.iter().flatten().copied().collect();
+        let points: Vec<[f32; 3]> = self.positions.iter().map(|p| p.to_array()).collect();
+        let options = meshopt::SimplifyOptions::LockBorder | meshopt::SimplifyOptions::ErrorAbsolute;
+        let kept = meshopt::simplify_decoder(&indices, &points, 0, 2f32.powi(exponent), options, None);
+        let mut triangles: Vec<[u32; 3]> = kept.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let simpler = if triangles.len() < self.triangles.len() {
+            let positions = used_positions(&self.positions, &mut triangles);
+            let name = format!("{} (shadow, error {})", self.name, 2f32.powi(exponent));
+            // The simplifier keeps area within a finite error; should it not, or open a closed
+            // mesh (large errors can: its silhouettes would stop being closed loops), the full
+            // mesh casts.
+            match Mesh::new(name, positions, triangles) {
+                Ok(m) if m.adjacency.is_closed() || !self.adjacency.is_closed() => Arc::new(m),
+                _ => self.clone(),
+            }
+        } else {
+            self.clone()
+        };
+        cache.push((exponent, simpler.clone()));
+        simpler
     }
 
     /// Unnormalised face normal (length = twice the area); zero for a degenerate triangle.
@@ -244,6 +284,20 @@ fn obj_shape(text: &str) -> std::result::Result<String, String> {
 }
 
 /// Merges bit-identical positions so faces share edges (OBJ files often repeat seam vertices).
+/// The positions `triangles` use, in order of first use; `triangles` renumbered into them.
+fn used_positions(positions: &[Vec3], triangles: &mut [[u32; 3]]) -> Vec<Vec3> {
+    let mut new = vec![u32::MAX; positions.len()];
+    let mut used = Vec::new();
+    for v in triangles.iter_mut().flatten() {
+        if new[*v as usize] == u32::MAX {
+            new[*v as usize] = used.len() as u32;
+            used.push(positions[*v as usize]);
+        }
+        *v = new[*v as usize];
+    }
+    used
+}
+
 fn weld(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
     let mut welded = Vec::with_capacity(positions.len());

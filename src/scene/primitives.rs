@@ -26,6 +26,13 @@ pub fn cylinder(radius: f32, height: f32) -> Result<Mesh> {
     Mesh::new("cylinder", p, tris)
 }
 
+/// A trefoil knot tube of about `triangles` triangles in the unit sphere (see
+/// [`shapes::torus_knot`]).
+pub fn knot(triangles: u32) -> Result<Mesh> {
+    let (p, tris) = shapes::torus_knot(triangles);
+    Mesh::new("knot", p, tris)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -47,6 +54,9 @@ mod tests {
             (cuboid(Vec3::new(1.0, 2.0, 3.0)).unwrap(), 6.0),
             (sphere(1.0).unwrap(), 4.0 / 3.0 * std::f32::consts::PI),
             (cylinder(0.5, 2.0).unwrap(), std::f32::consts::PI * 0.25 * 2.0),
+            // The tube's volume: its cross-section along the centre line (length 31.9 before
+            // the 1/3.4 fit into the unit sphere).
+            (knot(20_000).unwrap(), std::f32::consts::PI * 0.16 * 31.9 / 3.4f32.powi(3)),
         ] {
             assert!(mesh.adjacency.is_closed(), "{}", mesh.name);
             let v = signed_volume(&mesh);

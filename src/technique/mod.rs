@@ -15,6 +15,7 @@ pub mod projective_texture;
 pub mod reference;
 pub mod registry;
 pub mod shadow_map;
+pub mod shadow_mesh;
 pub mod shadow_volume;
 mod shadow_volume_gpu;
 pub mod smoothie;

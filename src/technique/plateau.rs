@@ -46,6 +46,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
+use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_caster};
 use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
@@ -65,9 +66,19 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "plateau",
     summary: "Haines' plateaus: hard drop shadow + cones and sheets at silhouettes, on the ground plane",
     kind: Kind::Realtime,
-    knobs: &[TEXTURE_SIZE, SIZE_MODE, PENUMBRA_SCALE, HAINES_FACTOR, CENTRED, CURVE, EDGES, OFF_PLANE],
+    knobs: &[
+        TEXTURE_SIZE,
+        SIZE_MODE,
+        PENUMBRA_SCALE,
+        HAINES_FACTOR,
+        CENTRED,
+        CURVE,
+        EDGES,
+        OFF_PLANE,
+        SHADOW_MESH_ERROR,
+    ],
     create: |ctx, _, visibility| Ok(Box::new(Plateau::new(ctx, visibility)?)),
-    bench: &[&[], OUTER_ONLY, OUTER_ONLY_NARROW, &[("texture_size", "512")]],
+    bench: &[&[], OUTER_ONLY, OUTER_ONLY_NARROW, &[("texture_size", "512")], &[("shadow_mesh_error", "1")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     // Issue 4: plateaus against the hard map at the same screen size.
     cost_goal: Some(CostGoal { setting: &[], baseline: &shadow_map::INFO, baseline_setting: &[], max_ratio: 1.3 }),
@@ -215,7 +226,7 @@ impl Plateau {
     }
 
     /// The plateau sides of every caster, rebuilt only for casters or a light that moved.
-    fn build_sides(&mut self, frame: &FrameInputs<'_>, plane: &ReceiverPlane, light: PlateauLight, edges: f64) {
+    fn build_sides(&mut self, frame: &FrameInputs<'_>, plane: &ReceiverPlane, light: PlateauLight, params: &Params) {
         let objects = &frame.scene.objects;
         self.sides.resize(objects.len(), None);
         self.frame += 1;
@@ -224,7 +235,8 @@ impl Plateau {
                 *cached = None;
                 continue;
             }
-            let source = match edges as u32 {
+            let o = &shadow_caster(o, light.position, params);
+            let source = match params.get(&EDGES) as u32 {
                 1 => EdgeSource::Silhouettes,
                 2 => EdgeSource::LightFacing,
                 // Open meshes have no closed silhouette: the connectivity-free mode of §3.
@@ -292,7 +304,7 @@ impl Technique for Plateau {
             penumbra: if centred { Penumbra::Centred } else { Penumbra::Outer },
             cone_segments: CONE_SEGMENTS,
         };
-        self.build_sides(frame, &plane, light, params.get(&EDGES));
+        self.build_sides(frame, &plane, light, params);
         let mut geometry = PlateauGeometry::default();
         self.sides.iter().flatten().for_each(|(_, g)| geometry.extend(g));
         let tex_size = params.get(&TEXTURE_SIZE) as u32;

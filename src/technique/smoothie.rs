@@ -42,6 +42,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
+use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_caster};
 use super::smoothie_gpu::GpuSilhouettes;
 use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
@@ -60,9 +61,19 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "smoothie",
     summary: "Chan & Durand's smoothies: shadow map + silhouette quads with remapped alpha, on every receiver",
     kind: Kind::Realtime,
-    knobs: &[MAP_SIZE, SMOOTHIE_SIZE, T, T_SCALE, CENTRED, SMOOTHIE_FALLOFF, DEPTH16, GPU_SILHOUETTES],
+    knobs: &[
+        MAP_SIZE,
+        SMOOTHIE_SIZE,
+        T,
+        T_SCALE,
+        CENTRED,
+        SMOOTHIE_FALLOFF,
+        DEPTH16,
+        GPU_SILHOUETTES,
+        SHADOW_MESH_ERROR,
+    ],
     create: |ctx, _, visibility| Ok(Box::new(Smoothie::new(ctx, visibility)?)),
-    bench: &[&[], OUTER_ONLY, &[("depth16", "1")], &[("gpu_silhouettes", "1")]],
+    bench: &[&[], OUTER_ONLY, &[("depth16", "1")], &[("gpu_silhouettes", "1")], &[("shadow_mesh_error", "1")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     // Issue 5: the smoothie's map is 1024² by default, so against the hard map at 1024².
     cost_goal: Some(CostGoal {
@@ -199,6 +210,7 @@ impl Smoothie {
     fn geometry(
         &mut self,
         frame: &FrameInputs<'_>,
+        params: &Params,
         view: &Mat4,
         (size, far): (SmoothieSize, f32),
         centred: bool,
@@ -212,6 +224,7 @@ impl Smoothie {
                 *cached = None;
                 continue;
             }
+            let o = &shadow_caster(o, light, params);
             let model = o.transform.matrix();
             let key = SilhouetteKey { mesh: o.mesh.id(), model, light };
             if cached.as_ref().is_none_or(|c| c.key != key) {
@@ -279,7 +292,7 @@ impl Technique for Smoothie {
             let (vertices, args) = gpu.record(frame, &frustum.view, (smoothie_size, frustum.far), centred)?;
             Smoothies::Indirect { vertices, args }
         } else {
-            let geometry = self.geometry(frame, &frustum.view, (smoothie_size, frustum.far), centred);
+            let geometry = self.geometry(frame, params, &frustum.view, (smoothie_size, frustum.far), centred);
             let vertices: Vec<SmoothieVertex> = geometry.vertices().copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
             if bytes.is_empty() {

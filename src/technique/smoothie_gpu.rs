@@ -2,7 +2,9 @@
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
 //! invocation per edge finds silhouettes and appends smoothie edges and corners
 //! (`glsl/smoothie/silhouettes.comp`); the smoothie pass draws them with an indirect draw.
-//! Each mesh's positions, triangles, edges and mailbox stamps are uploaded once.
+//! Each mesh's positions, triangles, edges and mailbox stamps are uploaded once. The output
+//! (one copy, not one per frame in flight) is only recomputed when a caster, the light view or
+//! the smoothie size changed: a static scene records no silhouette work after its first frame.
 
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
@@ -76,6 +78,17 @@ pub struct GpuSilhouettes {
     vertices: Option<PerFrame>,
     args: PerFrame,
     stamp: u32,
+    /// What the output was last computed from; `None` when it must be computed.
+    computed: Option<OutputKey>,
+}
+
+/// Everything the silhouette output depends on.
+#[derive(Clone, Debug, PartialEq)]
+struct OutputKey {
+    casters: Vec<(MeshId, Mat4)>,
+    size: [f32; 4],
+    centred: bool,
+    capacity: u64,
 }
 
 impl GpuSilhouettes {
@@ -91,6 +104,7 @@ impl GpuSilhouettes {
             vertices: None,
             args,
             stamp: 0,
+            computed: None,
         })
     }
 
@@ -137,6 +151,19 @@ impl GpuSilhouettes {
             SmoothieSize::Physical { light_radius, scale, behind } => (light_radius * scale, behind, true),
             SmoothieSize::Fixed(t) => (t, 0.0, false),
         };
+        // Slot 0 holds the one copy of the output (earlier frames may still draw from it: the
+        // barriers below order this frame's writes after their reads).
+        let (vertices, args) = (self.vertices.as_ref().expect("ensured").range(0), self.args.range(0));
+        let args = vk::DescriptorBufferInfo { range: 16, ..args };
+        let key = OutputKey {
+            casters: casters.iter().map(|o| (o.mesh.id(), *view * o.transform.matrix())).collect(),
+            size: [scale, f32::from(u8::from(physical)), far, behind],
+            centred,
+            capacity: self.vertices.as_ref().expect("ensured").capacity(),
+        };
+        if self.computed.as_ref() == Some(&key) {
+            return Ok((vertices, args));
+        }
         let pipeline = self.pipelines.get(physical, |&physical| {
             Pipeline::compute(
                 ctx,
@@ -163,16 +190,13 @@ impl GpuSilhouettes {
         }
         let params_buffer = self.params.as_mut().expect("ensured");
         params_buffer.write(frame.slot, cast_slice(&params));
-        let (params_range, vertices, args) = (
-            params_buffer.range(frame.slot),
-            self.vertices.as_ref().expect("ensured").range(frame.slot),
-            self.args.range(frame.slot),
-        );
-        let args = vk::DescriptorBufferInfo { range: 16, ..args };
+        let params_range = params_buffer.range(frame.slot);
 
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "silhouettes");
-        // Earlier frames' dispatches stamped the same meshes: finish them before this frame's.
+        // Earlier frames' draws read the output, and their dispatches stamped the same meshes:
+        // finish both before this frame's.
+        buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::TRANSFER_WRITE);
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
         update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0]));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
@@ -200,6 +224,7 @@ impl GpuSilhouettes {
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
         frame.timer.end(ctx, cmd);
+        self.computed = Some(key);
         Ok((vertices, args))
     }
 

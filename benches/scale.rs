@@ -1,0 +1,81 @@
+//! Cost at scale (issue 18) on koala.obj (99 994 triangles, 149 991 edges): silhouette
+//! extraction in edges per second, and the CPU geometry of a frame whose caster moved, for the
+//! plateau (world positions, silhouettes, cones and sheets) and the smoothie (world positions,
+//! silhouettes, smoothie edges and corners). Goal: at most 2 ms a moving frame.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{Mat4, Vec3};
+use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::smoothie::{self, SmoothieSize, depth_range, silhouette, smoothies};
+use softshadow::geometry::{Aabb, fit_spot_frustum};
+use softshadow::scene::Mesh;
+
+fn scale(c: &mut Criterion) {
+    let koala = Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/koala.obj")).unwrap();
+    // As scenes/scale/koala.toml places it: standing, 1.4 m tall, over the ground.
+    let model = Mat4::from_translation(Vec3::new(0.0, 0.7, 0.0))
+        * Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+        * Mat4::from_scale(Vec3::splat(0.15));
+    let light = Vec3::new(2.0, 7.0, 1.5);
+    let world = |m: &Mat4| -> Vec<Vec3> { koala.positions.iter().map(|p| m.transform_point3(*p)).collect() };
+    let positions = world(&model);
+    let caster = Caster { positions: &positions, triangles: &koala.triangles, adjacency: &koala.adjacency };
+
+    let mut group = c.benchmark_group("koala (99 994 triangles)");
+    group.throughput(Throughput::Elements(koala.adjacency.edges.len() as u64));
+    group.bench_function("silhouette extraction (edges/s)", |b| {
+        b.iter(|| penumbra_edges(&caster, &light_facing(black_box(&caster), light), EdgeSource::Silhouettes))
+    });
+    group.throughput(Throughput::Elements(1));
+    let plane = ReceiverPlane::ground(0.0);
+    // The defaults: centred penumbrae of the physical size.
+    let plateau_light = PlateauLight {
+        position: light,
+        radius: 0.3,
+        size: PenumbraSize::Physical { scale: 1.0 },
+        penumbra: plateau::Penumbra::Centred,
+        cone_segments: 32,
+    };
+    let (mut mailbox, mut frame) = (Mailbox::default(), 0);
+    let mut step = 0.0f32;
+    group.bench_function("plateau CPU geometry, moving frame", |b| {
+        b.iter(|| {
+            step += 1e-3;
+            frame += 1;
+            let positions = world(&(Mat4::from_translation(Vec3::X * step) * model));
+            let caster = Caster { positions: &positions, triangles: &koala.triangles, adjacency: &koala.adjacency };
+            plateau_sides(&plane, &plateau_light, &caster, 0.0, EdgeSource::Silhouettes, &mut mailbox, frame)
+        })
+    });
+    let bounds = Aabb::from_points(positions.iter().copied());
+    let ground = [(-6.0, -6.0), (6.0, -6.0), (6.0, 6.0), (-6.0, 6.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
+    let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the koala is in view");
+    let size = (SmoothieSize::Physical { light_radius: 0.3, scale: 1.0, behind: 0.0 }, frustum.far);
+    let (near, far) = depth_range(&frustum.view, &bounds);
+    group.bench_function("smoothie CPU geometry, moving frame", |b| {
+        b.iter(|| {
+            step += 1e-3;
+            frame += 1;
+            let positions = world(&(Mat4::from_translation(Vec3::X * step) * model));
+            let caster = Caster { positions: &positions, triangles: &koala.triangles, adjacency: &koala.adjacency };
+            let edges = silhouette(&caster, light);
+            smoothies(
+                &frustum.view,
+                &caster,
+                &edges,
+                size,
+                smoothie::Penumbra::Centred { near, far },
+                &mut mailbox,
+                frame,
+            )
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, scale);
+criterion_main!(benches);

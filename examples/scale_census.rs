@@ -1,0 +1,145 @@
+//! Where the plateau's and smoothie's time goes on a scene (issue 18, step 2): per caster, the
+//! silhouette edges and vertices, the primitives of the cones, sheets and smoothies, and the
+//! fragments they rasterise (the summed area of their triangles in texels of the plateau
+//! texture or smoothie buffer: each texel a triangle covers is one fragment, overlaps
+//! counted once per triangle), with the CPU milliseconds of one moving frame's geometry.
+//!
+//! `cargo run --release --example scale_census -- scenes/scale/koala.toml [texels]`
+
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
+use softshadow::geometry::{Aabb, fit_spot_frustum};
+use softshadow::scene::Scene;
+use softshadow::technique::shadow_mesh::texels_at_caster;
+
+/// What the plateau and smoothie use by default: centred penumbrae of the physical size, the
+/// plateau's cone segments and 1024² targets.
+const CONE_SEGMENTS: u32 = 32;
+
+/// Summed triangle area of a triangle list of 2D points.
+fn area(points: impl Iterator<Item = Vec2>) -> f64 {
+    let p: Vec<Vec2> = points.collect();
+    p.chunks_exact(3).map(|t| f64::from((t[1] - t[0]).perp_dot(t[2] - t[0]).abs()) * 0.5).sum()
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let path = args.next().ok_or("usage: scale_census SCENE.toml [texels]")?;
+    let texels: f64 = args.next().map_or(Ok(1024.0), |t| t.parse())?;
+    let scene = Scene::load(&path)?;
+    let ground = scene.ground.ok_or("the census needs a ground plane")?;
+    let light = scene.light.position;
+    let plane = ReceiverPlane::ground(ground.height);
+    let plateau_light = PlateauLight {
+        position: light,
+        radius: scene.light.radius,
+        size: PenumbraSize::Physical { scale: 1.0 },
+        penumbra: plateau::Penumbra::Centred,
+        cone_segments: CONE_SEGMENTS,
+    };
+    let h = ground.half_size;
+    let receivers = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, z)| Vec3::new(x, ground.height, z));
+    println!(
+        "| caster | triangles | edges | boundary | silhouette edges | CPU ms: transform, facing+edges, plateau sides, smoothies | cone tris | sheet tris | plateau fragments (1024²) | smoothie edge tris | corner tris | smoothie fragments |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for o in scene.objects.iter().filter(|o| o.casts) {
+        let mesh = &o.mesh;
+        let model = o.transform.matrix();
+        let started = Instant::now();
+        let positions: Vec<Vec3> = mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
+        let transform_ms = started.elapsed().as_secs_f64() * 1e3;
+        let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let source = if mesh.adjacency.is_closed() { EdgeSource::Silhouettes } else { EdgeSource::LightFacing };
+        let started = Instant::now();
+        let facing = light_facing(&caster, light);
+        let edges = penumbra_edges(&caster, &facing, source);
+        let edges_ms = started.elapsed().as_secs_f64() * 1e3;
+        let closed_edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
+
+        let started = Instant::now();
+        let sides = plateau_sides(&plane, &plateau_light, &caster, 0.0, source, &mut Mailbox::default(), 1);
+        let sides_ms = started.elapsed().as_secs_f64() * 1e3;
+        let (lo, hi) = sides.footprint.unwrap_or((Vec2::ZERO, Vec2::ONE));
+        let plateau_texel = (texels * texels) / f64::from((hi - lo).x * (hi - lo).y).max(1e-12);
+        let uv = |v: &PlateauVertex| Vec2::new(v.u, v.v);
+        let cone_fragments = area(sides.cones.iter().map(uv)) * plateau_texel;
+        let sheet_fragments = area(sides.sheets.iter().map(uv)) * plateau_texel;
+
+        if source != EdgeSource::Silhouettes {
+            // What the open mesh would cost if only the edges bounding its lit part had sides.
+            let started = Instant::now();
+            let bounding = plateau_sides(
+                &plane,
+                &plateau_light,
+                &caster,
+                0.0,
+                EdgeSource::Silhouettes,
+                &mut Mailbox::default(),
+                1,
+            );
+            let ms = started.elapsed().as_secs_f64() * 1e3;
+            let fragments =
+                (area(bounding.cones.iter().map(uv)) + area(bounding.sheets.iter().map(uv))) * plateau_texel;
+            println!(
+                "{}: with only the edges bounding the lit part (silhouettes and lit boundary edges): {} cone tris, {} sheet tris, {fragments:.0} fragments, {ms:.2} CPU ms",
+                o.name,
+                bounding.cones.len() / 3,
+                bounding.sheets.len() / 3
+            );
+        }
+        for texels in [1.0, 4.0] {
+            let world = texels_at_caster(o, light, texels).ok_or("the light is inside the caster")?;
+            let started = Instant::now();
+            let simple = o.mesh.shadow_mesh(world / o.transform.scale.abs().max_element());
+            println!(
+                "{}: shadow mesh within {texels} texel(s): {} triangles, closed {}, simplified in {:.0} ms",
+                o.name,
+                simple.triangles.len(),
+                simple.adjacency.is_closed(),
+                started.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        let bounds = Aabb::from_points(positions.iter().copied());
+        let frustum =
+            fit_spot_frustum(light, scene.light.target, &[bounds], &receivers).frustum.ok_or("not in view")?;
+        let behind = frustum.view.transform_point3(light).length();
+        let size = SmoothieSize::Physical { light_radius: scene.light.radius, scale: 1.0, behind };
+        let frustum = frustum.grown(size.largest_reach(frustum.near, frustum.far));
+        let started = Instant::now();
+        let (near, far) = depth_range(&frustum.view, &bounds);
+        let penumbra = smoothie::Penumbra::Centred { near, far };
+        let g =
+            smoothies(&frustum.view, &caster, &closed_edges, (size, frustum.far), penumbra, &mut Mailbox::default(), 1);
+        let smoothie_ms = started.elapsed().as_secs_f64() * 1e3;
+        let [x0, y0, x1, y1] = frustum.window;
+        let smoothie_texel = (texels * texels) / f64::from((x1 - x0) * (y1 - y0));
+        let xy = |v: &SmoothieVertex| Vec2::new(v.x, v.y);
+        let edge_fragments = area(g.edges.iter().map(xy)) * smoothie_texel;
+        let corner_fragments = area(g.corners.iter().map(xy)) * smoothie_texel;
+        println!(
+            "| {} | {} | {} | {} | {} ({} for the plateau) | {transform_ms:.2}, {edges_ms:.2}, {sides_ms:.2}, {smoothie_ms:.2} | {} | {} | cones {:.0} ({:.1}× the texture), sheets {:.0} | {} | {} | edges {:.0}, corners {:.0} ({:.1}× the buffer) |",
+            o.name,
+            mesh.triangles.len(),
+            mesh.adjacency.edges.len(),
+            mesh.adjacency.boundary,
+            closed_edges.len(),
+            edges.len(),
+            sides.cones.len() / 3,
+            sides.sheets.len() / 3,
+            cone_fragments,
+            cone_fragments / (texels * texels),
+            sheet_fragments,
+            g.edges.len() / 3,
+            g.corners.len() / 3,
+            edge_fragments,
+            corner_fragments,
+            (edge_fragments + corner_fragments) / (texels * texels),
+        );
+    }
+    Ok(())
+}

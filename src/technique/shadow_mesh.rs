@@ -1,0 +1,49 @@
+//! The optional simplified shadow mesh per caster, the DDJ's "separate shadowing and drawing
+//! models": the silhouette techniques find silhouettes on a simpler copy of each caster
+//! ([`Mesh::shadow_mesh`]) while the camera still draws the full one. The error bound is in
+//! texels of the light's view, so a technique sets it where a texel is what it can show.
+
+use glam::Vec3;
+
+use super::knobs::{Knob, Params};
+use crate::scene::Object;
+
+/// Declared by each technique that casts from [`shadow_caster`].
+pub const SHADOW_MESH_ERROR: Knob = Knob {
+    name: "shadow_mesh_error",
+    default: 0.0,
+    min: 0.0,
+    max: 64.0,
+    integer: false,
+    help: "silhouettes from a simplified caster straying at most this many texels of a 1024² light view fitted to it; 0: the full mesh",
+};
+
+/// Texels across the light's view of one caster that [`SHADOW_MESH_ERROR`] counts in.
+pub const LIGHT_VIEW_TEXELS: f32 = 1024.0;
+
+/// The world distance at `o` that subtends `texels` texels of a [`LIGHT_VIEW_TEXELS`]² view
+/// from `light` fitted to the caster's bounding sphere, at the sphere's point nearest the light
+/// (where a texel is smallest, so the bound holds for the whole caster); `None` for a light
+/// inside the sphere.
+pub fn texels_at_caster(o: &Object, light: Vec3, texels: f32) -> Option<f32> {
+    let b = o.bounds();
+    let (centre, radius) = ((b.min + b.max) * 0.5, (b.max - b.min).length() * 0.5);
+    let distance = (centre - light).length();
+    (distance > radius).then(|| {
+        let texel_angle = 2.0 * (radius / distance).asin() / LIGHT_VIEW_TEXELS;
+        texels * texel_angle * (distance - radius)
+    })
+}
+
+/// `o` as its shadow is cast: with [`SHADOW_MESH_ERROR`] set, a copy whose mesh is the
+/// simplified one within that many texels (converted through the largest scale to the mesh's
+/// own units); otherwise `o` unchanged.
+pub fn shadow_caster(o: &Object, light: Vec3, params: &Params) -> Object {
+    let texels = params.get(&SHADOW_MESH_ERROR) as f32;
+    let world = if texels > 0.0 { texels_at_caster(o, light, texels) } else { None };
+    let mut o = o.clone();
+    if let Some(world) = world {
+        o.mesh = o.mesh.shadow_mesh(world / o.transform.scale.abs().max_element());
+    }
+    o
+}

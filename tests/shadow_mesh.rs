@@ -1,0 +1,78 @@
+//! The simplified shadow mesh (issue 18) keeps the shadow within its stated error: seen from
+//! the light, its outline strays from the full mesh's by no more than the bound in texels of
+//! the light's view ([`LIGHT_VIEW_TEXELS`]² fitted to the caster), with fewer triangles.
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use softshadow::scene::{Mesh, Object, primitives};
+use softshadow::technique::shadow_mesh::{LIGHT_VIEW_TEXELS, texels_at_caster};
+
+const LIGHT: Vec3 = Vec3::new(2.0, 7.0, 1.5);
+
+/// Which cells of an N × N grid over the caster's tangent-plane bounds from the light its
+/// triangles cover (cell centres), N chosen so a cell is one texel of the light's view.
+fn silhouette_mask(o: &Object, mesh: &Mesh) -> (Vec<bool>, usize) {
+    let b = o.bounds();
+    let (centre, radius) = ((b.min + b.max) * 0.5, (b.max - b.min).length() * 0.5);
+    let axis = (centre - LIGHT).normalize();
+    let u = axis.cross(Vec3::Y).normalize();
+    let v = u.cross(axis);
+    let half = (radius / (centre - LIGHT).length()).asin().tan();
+    let n = LIGHT_VIEW_TEXELS as usize;
+    let model = o.transform.matrix();
+    let cell = |p: Vec3| {
+        let d = model.transform_point3(p) - LIGHT;
+        (Vec2::new(d.dot(u), d.dot(v)) / d.dot(axis) + half) / (2.0 * half) * n as f32
+    };
+    let mut mask = vec![false; n * n];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| cell(mesh.positions[i as usize]));
+        let (lo, hi) = (a.min(b).min(c).max(Vec2::ZERO), a.max(b).max(c).min(Vec2::splat(n as f32 - 1.0)));
+        let area = (b - a).perp_dot(c - a);
+        for y in lo.y.floor() as usize..=hi.y.ceil() as usize {
+            for x in lo.x.floor() as usize..=hi.x.ceil() as usize {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let w = [(c - b).perp_dot(p - b), (a - c).perp_dot(p - c), (b - a).perp_dot(p - a)];
+                if w.iter().all(|w| w * area >= 0.0) {
+                    mask[y * n + x] = true;
+                }
+            }
+        }
+    }
+    (mask, n)
+}
+
+/// Cells where the masks differ that lie farther than `reach` cells from the full outline.
+fn strays(full: &[bool], simple: &[bool], n: usize, reach: usize) -> Vec<(usize, usize)> {
+    let near_outline = |x: usize, y: usize| {
+        let inside = full[y * n + x];
+        let ys = y.saturating_sub(reach)..=(y + reach).min(n - 1);
+        ys.flat_map(|yy| (x.saturating_sub(reach)..=(x + reach).min(n - 1)).map(move |xx| (xx, yy)))
+            .any(|(xx, yy)| full[yy * n + xx] != inside)
+    };
+    (0..n * n).filter(|&i| full[i] != simple[i]).map(|i| (i % n, i / n)).filter(|&(x, y)| !near_outline(x, y)).collect()
+}
+
+#[test]
+fn the_simplified_shadow_mesh_stays_within_its_stated_error() {
+    let mut o = Object::new("knot", Arc::new(primitives::knot(20_000).unwrap()));
+    o.transform.position = Vec3::new(0.0, 1.0, 0.0);
+    o.transform.scale = Vec3::splat(0.8);
+    let (full, n) = silhouette_mask(&o, &o.mesh);
+    for texels in [1.0, 4.0] {
+        let world = texels_at_caster(&o, LIGHT, texels).expect("the light is outside the caster");
+        let simple = o.mesh.shadow_mesh(world / 0.8);
+        assert!(simple.triangles.len() < o.mesh.triangles.len(), "{texels} texels: {}", simple.triangles.len());
+        assert!(simple.adjacency.is_closed(), "a closed mesh stays closed: its silhouettes stay closed loops");
+        let (mask, _) = silhouette_mask(&o, &simple);
+        // One more cell for where a cell centre falls on either side of an outline.
+        let out = strays(&full, &mask, n, texels as usize + 1);
+        assert!(out.is_empty(), "{texels} texels: {} cells stray, e.g. {:?}", out.len(), &out[..out.len().min(5)]);
+    }
+    // An error so large that the simplifier would open the knot: the full mesh casts.
+    let huge = o.mesh.shadow_mesh(0.5);
+    assert!(huge.adjacency.is_closed());
+    // No error allowed: the full mesh itself.
+    assert!(Arc::ptr_eq(&o.mesh.shadow_mesh(0.0), &o.mesh));
+}
