@@ -137,9 +137,11 @@ fn depth_bytes(depth: &[f32], format: vk::Format) -> Vec<u8> {
 
 /// The embedder's depth prepass on the GPU: its own pipeline, descriptor set, buffers and
 /// dynamic rendering pass, drawing the scene's meshes (objects, then the ground) into its D32
-/// reverse-Z depth. Its vertex stage is the engine's published prepass shader, so that the depth
-/// it rasterizes is the engine's bit for bit: V then has nothing to differ by but the engine's own
-/// work (a ray-cast depth differs in the last bits, and PCF moved by up to 5 LSB on 9 pixels).
+/// reverse-Z depth. Its stages are the engine's published prepass shaders (the fragment stage
+/// writes the ground's depth as the camera ray's exact hit on its plane, as the engine does), so
+/// that its depth is the engine's bit for bit: V then has nothing to differ by but the engine's
+/// own work (a ray-cast depth differs in the last bits, and PCF moved by up to 5 LSB on 9 pixels;
+/// a rasterized ground, by 3 LSB on 1).
 struct DepthPrepass {
     set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
@@ -164,14 +166,29 @@ impl DepthPrepass {
         );
         let meshes = s.objects.iter().map(|o| (&*o.mesh, o.transform.matrix())).chain([(&plate, ground_model)]);
         let (mut vertices, mut indices, mut objects, mut draws) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for (mesh, model) in meshes {
+        // The ground's last normal-matrix column is its plane, which the fragment stage meets.
+        let plane = Vec4::new(0.0, 1.0, 0.0, -ground.height);
+        let count = s.objects.len();
+        for (n, (mesh, model)) in meshes.enumerate() {
             let (v, i) = mesh.render_geometry();
             draws.push((i.len() as u32, indices.len() as u32, vertices.len() as i32));
-            objects.push(ObjectData { model, normal_matrix: Mat4::IDENTITY, albedo: Vec4::ZERO });
+            let last = if n == count { plane } else { Vec4::W };
+            let normal_matrix = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::Z, last);
+            objects.push(ObjectData { model, normal_matrix, albedo: Vec4::ZERO });
             vertices.extend(v);
             indices.extend(i);
         }
-        let globals = FrameGlobals { view_proj: camera.projection * camera.view, ..bytemuck::Zeroable::zeroed() };
+        let cam =
+            CameraProjection::from_matrices(camera.view, camera.projection, camera.reverse_z, camera.near, camera.far)
+                .unwrap();
+        let globals = FrameGlobals {
+            view_proj: cam.view_proj,
+            inv_view_proj: cam.inv_view_proj,
+            camera_position: cam.position.extend(1.0),
+            camera_forward: cam.forward.extend(0.0),
+            viewport: Vec4::new(SIDE as f32, SIDE as f32, 1.0 / SIDE as f32, 1.0 / SIDE as f32),
+            ..bytemuck::Zeroable::zeroed()
+        };
         let usage = vk::BufferUsageFlags::VERTEX_BUFFER
             | vk::BufferUsageFlags::INDEX_BUFFER
             | vk::BufferUsageFlags::UNIFORM_BUFFER
@@ -196,7 +213,7 @@ impl DepthPrepass {
                     .binding(i as u32)
                     .descriptor_type(t)
                     .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::VERTEX)
+                    .stage_flags(vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)
             })
             .collect();
         let sizes = bindings.map(|ty| vk::DescriptorPoolSize { ty, descriptor_count: 1 });
@@ -225,12 +242,16 @@ impl DepthPrepass {
             d.update_descriptor_sets(&writes, &[]);
             let layout =
                 d.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None).unwrap();
-            let code = softshadow::gpu::shaders::PREPASS_SCENE_VERT.words;
-            let module = d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None).unwrap();
-            let stages = [vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(module)
-                .name(c"main")];
+            let published = [
+                (vk::ShaderStageFlags::VERTEX, softshadow::gpu::shaders::PREPASS_SCENE_VERT.words),
+                (vk::ShaderStageFlags::FRAGMENT, softshadow::gpu::shaders::PREPASS_SCENE_FRAG.words),
+            ];
+            let modules = published.map(|(_, code)| {
+                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None).unwrap()
+            });
+            let stages = [0, 1].map(|i| {
+                vk::PipelineShaderStageCreateInfo::default().stage(published[i].0).module(modules[i]).name(c"main")
+            });
             let stride = std::mem::size_of::<softshadow::scene::Vertex>() as u32;
             let vertex_bindings =
                 [vk::VertexInputBindingDescription { binding: 0, stride, input_rate: vk::VertexInputRate::VERTEX }];
@@ -273,7 +294,7 @@ impl DepthPrepass {
                 .layout(layout)
                 .push_next(&mut rendering)];
             let pipeline = d.create_graphics_pipelines(vk::PipelineCache::null(), &ci, None).unwrap()[0];
-            d.destroy_shader_module(module, None);
+            modules.into_iter().for_each(|m| d.destroy_shader_module(m, None));
             DepthPrepass { set_layout, layout, pipeline, pool, set, buffers, draws }
         }
     }
