@@ -32,6 +32,18 @@ fn generated_header() -> String {
     String::from_utf8(out).unwrap()
 }
 
+/// The `NAME MS` pairs a C program printed on lines starting with `prefix`.
+fn passes<'a>(stdout: &'a str, prefix: &str) -> Vec<(&'a str, f64)> {
+    stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix(prefix))
+        .map(|l| {
+            let mut parts = l.split(' ');
+            (parts.next().unwrap(), parts.next().unwrap().parse().unwrap())
+        })
+        .collect()
+}
+
 /// A fresh generation equals include/softshadow.h; `SOFTSHADOW_BLESS=1` rewrites it instead.
 #[test]
 fn the_checked_in_header_is_generated_from_the_code() {
@@ -102,14 +114,7 @@ fn the_c_game_loop_runs_and_shadows_where_physics_says() {
     eprintln!("{stdout}{}", String::from_utf8_lossy(&output.stderr));
     assert!(output.status.success(), "game_loop failed");
     assert!(stdout.contains("technique shadow-map") && stdout.contains("technique pcss"), "{stdout}");
-    let last: Vec<(&str, f64)> = stdout
-        .lines()
-        .filter_map(|l| l.strip_prefix("frame 199 pass "))
-        .map(|l| {
-            let mut parts = l.split(' ');
-            (parts.next().unwrap(), parts.next().unwrap().parse().unwrap())
-        })
-        .collect();
+    let last = passes(&stdout, "frame 199 pass ");
     let names: Vec<_> = last.iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["prepass", "shadow_map", "resolve", "composite"], "{stdout}");
     assert!(last.iter().all(|(_, ms)| *ms > 0.0), "{last:?}");
@@ -147,14 +152,7 @@ fn a_c_renderer_records_the_shadow_into_its_own_command_buffers() {
     let host = stdout.lines().find_map(|l| l.strip_prefix("host blocks through the callbacks: ")).expect("host blocks");
     let made: usize = host.split(' ').next().unwrap().parse().unwrap();
     assert!(made > 0 && host.ends_with(" 0 alive after the engine"), "the embedder's host allocator: {host}");
-    let passes: Vec<(&str, f64)> = stdout
-        .lines()
-        .filter_map(|l| l.strip_prefix("pass "))
-        .map(|l| {
-            let mut parts = l.split(' ');
-            (parts.next().unwrap(), parts.next().unwrap().parse().unwrap())
-        })
-        .collect();
+    let passes = passes(&stdout, "pass ");
     let names: Vec<_> = passes.iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["import", "shadow_map", "resolve"], "{stdout}");
     assert!(passes.iter().all(|(_, ms)| *ms > 0.0), "{passes:?}");

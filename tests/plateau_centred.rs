@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{engine, finish, reference, render_with, scene, suite_scene, top_down};
+use common::{engine, error_minimising_scale, finish, reference, render_with, scene, suite_scene, top_down};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -169,18 +169,8 @@ fn the_physical_penumbra_size_minimises_the_error() {
     let scales = ["0.5", "0.65", "0.8", "1", "1.25", "1.6", "2"];
     let mut e = engine();
     for name in ["plate", "sphere"] {
-        let s = suite_scene(name);
-        let truth = reference(&mut e, &s, 96);
-        let errors: Vec<f64> = scales
-            .iter()
-            .map(|k| {
-                let v = render_with(&mut e, &s, "plateau", &[("penumbra_scale", k)], 96);
-                Metrics::between(&v, &truth).unwrap().penumbra_rmse
-            })
-            .collect();
-        let best = (0..scales.len()).min_by(|&a, &b| errors[a].total_cmp(&errors[b])).unwrap();
-        eprintln!("{name}: penumbra RMSE by scale {scales:?}: {errors:.4?}");
-        assert!((2..=4).contains(&best), "{name}: least error at scale {} ({errors:.4?})", scales[best]);
+        let best = error_minimising_scale(&mut e, name, ("plateau", "penumbra_scale", &[]), &scales);
+        assert!(["0.8", "1", "1.25"].contains(&best), "{name}: least error at scale {best}");
     }
     finish(e);
 }

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{engine, finish, reference, render_with, suite_scene};
+use common::{engine, error_minimising_scale, finish, reference, render_with, suite_scene};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -149,19 +149,8 @@ fn the_physical_size_is_the_error_minimising_one() {
     let scales = ["0.5", "0.8", "1", "1.25", "2"];
     let mut e = engine();
     for name in ["plate", "sphere"] {
-        let s = suite_scene(name);
-        let truth = reference(&mut e, &s, 96);
-        let errors: Vec<f64> = scales
-            .iter()
-            .map(|k| {
-                let c = render_with(&mut e, &s, "smoothie", &[("penumbra", "1"), ("t_scale", k)], 96);
-                Metrics::between(&c, &truth).unwrap().penumbra_rmse
-            })
-            .collect();
-        let curve: Vec<String> = scales.iter().zip(&errors).map(|(k, e)| format!("{k}: {e:.4}")).collect();
-        eprintln!("{name}: penumbra RMSE by t_scale {}", curve.join(", "));
-        let best = (0..scales.len()).min_by(|&a, &b| errors[a].total_cmp(&errors[b])).unwrap();
-        assert!((1..=3).contains(&best), "{name}: the error is least at t_scale {}", scales[best]);
+        let best = error_minimising_scale(&mut e, name, ("smoothie", "t_scale", &[("penumbra", "1")]), &scales);
+        assert!(["0.8", "1", "1.25"].contains(&best), "{name}: the error is least at t_scale {best}");
     }
     finish(e);
 }

@@ -177,3 +177,27 @@ pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
     }
     m
 }
+
+/// The scale among `scales` (values of `knob`, ascending, with `fixed` knobs set too) at which
+/// `technique`'s penumbra RMSE against the reference is least on the suite scene `name`, at 96²:
+/// what the issue-20 tests hold to lie within [0.8, 1.25] of the physical size.
+pub fn error_minimising_scale(
+    e: &mut Engine,
+    name: &str,
+    (technique, knob, fixed): (&str, &str, &[(&str, &str)]),
+    scales: &[&'static str],
+) -> &'static str {
+    let s = suite_scene(name);
+    let truth = reference(e, &s, 96);
+    let errors: Vec<f64> = scales
+        .iter()
+        .map(|k| {
+            let knobs: Vec<_> = fixed.iter().copied().chain([(knob, *k)]).collect();
+            let v = render_with(e, &s, technique, &knobs, 96);
+            softshadow::measure::Metrics::between(&v, &truth).unwrap().penumbra_rmse
+        })
+        .collect();
+    eprintln!("{technique} on {name}: penumbra RMSE by {knob} {scales:?}: {errors:.4?}");
+    let best = (0..scales.len()).min_by(|&a, &b| errors[a].total_cmp(&errors[b])).unwrap();
+    scales[best]
+}
