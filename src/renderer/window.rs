@@ -48,9 +48,18 @@ pub struct WindowStats {
     pub skipped_frames: u64,
 }
 
+/// Where a presenter learns the window's size each frame.
+enum Size {
+    /// A winit window: its inner size.
+    Winit(Arc<Window>),
+    /// A native X11 window the embedder owns: the surface's current extent, which X11 keeps
+    /// equal to the window's size.
+    Surface,
+}
+
 /// A window's swapchain and the composite for its format.
 pub(super) struct Presenter {
-    window: Arc<Window>,
+    window: Size,
     request: WindowOptions,
     /// `None` until the window first has an area.
     swapchain: Option<Swapchain>,
@@ -64,7 +73,7 @@ pub(super) struct Presenter {
 }
 
 impl Presenter {
-    fn new(window: Arc<Window>, request: WindowOptions) -> Self {
+    fn new(window: Size, request: WindowOptions) -> Self {
         let stats = WindowStats {
             format: vk::Format::UNDEFINED,
             present_mode: vk::PresentModeKHR::FIFO,
@@ -88,7 +97,12 @@ impl Presenter {
 
     /// The swapchain's size once it matches the window, `None` while the window has no area.
     fn prepare(&mut self, ctx: &Context) -> Result<Option<vk::Extent2D>> {
-        let size = self.window.inner_size();
+        let size = match &self.window {
+            Size::Winit(window) => window.inner_size(),
+            Size::Surface => {
+                ctx.surface_extent()?.map_or(PhysicalSize::default(), |e| PhysicalSize::new(e.width, e.height))
+            }
+        };
         let made_for = self.swapchain.as_ref().map(|_| self.made_for);
         let extent = match step(made_for, self.stale, size, || ctx.surface_extent())? {
             Step::Reuse => return Ok(Some(self.swapchain.as_ref().expect("made").extent())),
@@ -223,7 +237,25 @@ impl Engine {
     /// present, with a swapchain made when the window first has an area.
     pub fn windowed(options: &ContextOptions, window: Arc<Window>, request: WindowOptions) -> Result<Self> {
         let mut engine = Engine::on(Context::windowed(options, window.clone())?)?;
-        engine.window = Some(Presenter::new(window, request));
+        engine.window = Some(Presenter::new(Size::Winit(window), request));
+        Ok(engine)
+    }
+
+    /// An engine presenting to the embedder's Xlib `window` on `display` (the C ABI's
+    /// `softshadow_engine_create_xlib`), at the window's size, which it reads from the surface
+    /// each frame.
+    ///
+    /// # Safety
+    /// `display` is an open Xlib `Display*` and `window` a window on it; both outlive the engine.
+    pub unsafe fn from_xlib(
+        options: &ContextOptions,
+        display: *mut std::ffi::c_void,
+        window: std::ffi::c_ulong,
+        request: WindowOptions,
+    ) -> Result<Self> {
+        // SAFETY: the caller's contract, passed on.
+        let mut engine = Engine::on(unsafe { Context::xlib(options, display, window) }?)?;
+        engine.window = Some(Presenter::new(Size::Surface, request));
         Ok(engine)
     }
 
