@@ -171,6 +171,17 @@ const char *softshadow_required_device_extension(size_t index);
 enum softshadow_status softshadow_engine_create_headless(uint32_t validation,
                                                          struct softshadow_engine **out_engine);
 
+// Creates an engine on a device of its own that presents to the embedder's Xlib `window` on
+// `display` (`Display*` and `Window`), FIFO, at the window's size; `validation` as for
+// `softshadow_engine_create_headless`. Present frames with `softshadow_present`.
+//
+// # Safety
+// `display` is an open display and `window` a window on it; both outlive the engine.
+enum softshadow_status softshadow_engine_create_xlib(void *display,
+                                                     unsigned long window,
+                                                     uint32_t validation,
+                                                     struct softshadow_engine **out_engine);
+
 // Creates an engine on the embedder's Vulkan objects; it never destroys them. A device
 // without a required extension or feature is refused (`SOFTSHADOW_ERROR_INVALID`, the
 // message naming it).
@@ -219,6 +230,25 @@ enum softshadow_status softshadow_engine_set_knob(struct softshadow_engine *engi
 // `engine` and `scene` are live handles.
 enum softshadow_status softshadow_render(struct softshadow_engine *engine,
                                          const struct softshadow_scene *scene);
+
+// Renders one frame of `scene` at the window's size and presents it (an engine made by
+// `softshadow_engine_create_xlib`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
+// has no area and the frame was skipped. Its pass times arrive a frame or two later.
+//
+// # Safety
+// `engine` and `scene` are live handles; `out_shown` is NULL or writable.
+enum softshadow_status softshadow_present(struct softshadow_engine *engine,
+                                          const struct softshadow_scene *scene,
+                                          uint32_t *out_shown);
+
+// The size of the swapchain the last presented frame went to (an engine made by
+// `softshadow_engine_create_xlib`), into `*out_width` and `*out_height`; 0×0 before any.
+//
+// # Safety
+// `engine` is a live handle; the outputs are writable.
+enum softshadow_status softshadow_window_size(const struct softshadow_engine *engine,
+                                              uint32_t *out_width,
+                                              uint32_t *out_height);
 
 // Renders one frame and copies it out (waits for the GPU): sRGB RGBA8 color into `color`
 // (`color_len` ≥ width·height·4 bytes) and V as round(V·65535) into `visibility`

@@ -17,7 +17,7 @@
 #![allow(non_camel_case_types)]
 
 use std::cell::RefCell;
-use std::ffi::{c_char, c_void};
+use std::ffi::{c_char, c_ulong, c_void};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
 
@@ -27,7 +27,9 @@ use glam::{Mat4, Vec3};
 use crate::error::Error;
 use crate::geometry::Projection;
 use crate::gpu::{Access, ContextOptions, EmbedderHandles};
-use crate::renderer::{EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, FrameSettings, FrameTimings};
+use crate::renderer::{
+    EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, FrameSettings, FrameTimings, Presented, WindowOptions,
+};
 use crate::scene::{Camera, Ground, Light, Mesh, Object, RenderSettings, Scene, Transform};
 use crate::technique::{Params, find};
 
@@ -368,6 +370,31 @@ pub extern "C" fn softshadow_engine_create_headless(
     })
 }
 
+/// Creates an engine on a device of its own that presents to the embedder's Xlib `window` on
+/// `display` (`Display*` and `Window`), FIFO, at the window's size; `validation` as for
+/// `softshadow_engine_create_headless`. Present frames with `softshadow_present`.
+///
+/// # Safety
+/// `display` is an open display and `window` a window on it; both outlive the engine.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn softshadow_engine_create_xlib(
+    display: *mut c_void,
+    window: c_ulong,
+    validation: u32,
+    out_engine: *mut *mut softshadow_engine,
+) -> softshadow_status {
+    guard(|| {
+        if display.is_null() {
+            return Err(Failure(SOFTSHADOW_ERROR_NULL, "display is NULL".into()));
+        }
+        non_null_mut(out_engine, "out_engine")?;
+        let options = ContextOptions { validation: validation != 0, ..ContextOptions::from_env() };
+        // SAFETY: the caller's contract, passed on.
+        let engine = unsafe { Engine::from_xlib(&options, display, window, WindowOptions::default()) }?;
+        new_engine(engine, out_engine)
+    })
+}
+
 /// Creates an engine on the embedder's Vulkan objects; it never destroys them. A device
 /// without a required extension or feature is refused (`SOFTSHADOW_ERROR_INVALID`, the
 /// message naming it).
@@ -508,12 +535,64 @@ pub unsafe extern "C" fn softshadow_render(
     engine: *mut softshadow_engine,
     scene: *const softshadow_scene,
 ) -> softshadow_status {
+    frame_of(engine, scene, |e, scene| Ok(e.engine.render(scene, &e.settings)?))
+}
+
+/// Renders a frame of `scene` with `draw` on a live engine, then keeps its timings.
+fn frame_of(
+    engine: *mut softshadow_engine,
+    scene: *const softshadow_scene,
+    draw: impl FnOnce(&mut softshadow_engine, &Scene) -> Result<(), Failure>,
+) -> softshadow_status {
     guard(|| {
         let e = non_null_mut(engine, "engine")?;
         let s = non_null(scene, "scene")?;
-        e.engine.render(&s.scene, &e.settings)?;
+        draw(e, &s.scene)?;
         keep_timings(e);
         Ok(())
+    })
+}
+
+/// Renders one frame of `scene` at the window's size and presents it (an engine made by
+/// `softshadow_engine_create_xlib`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
+/// has no area and the frame was skipped. Its pass times arrive a frame or two later.
+///
+/// # Safety
+/// `engine` and `scene` are live handles; `out_shown` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn softshadow_present(
+    engine: *mut softshadow_engine,
+    scene: *const softshadow_scene,
+    out_shown: *mut u32,
+) -> softshadow_status {
+    frame_of(engine, scene, |e, scene| {
+        let shown = e.engine.present(scene, &e.settings.params)? == Presented::Shown;
+        if !out_shown.is_null() {
+            // SAFETY: writable, by the caller's contract.
+            unsafe { *out_shown = shown as u32 };
+        }
+        Ok(())
+    })
+}
+
+/// The size of the swapchain the last presented frame went to (an engine made by
+/// `softshadow_engine_create_xlib`), into `*out_width` and `*out_height`; 0×0 before any.
+///
+/// # Safety
+/// `engine` is a live handle; the outputs are writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn softshadow_window_size(
+    engine: *const softshadow_engine,
+    out_width: *mut u32,
+    out_height: *mut u32,
+) -> softshadow_status {
+    guard(|| {
+        let e = non_null(engine, "engine")?;
+        let stats = e.engine.window_stats().ok_or_else(|| {
+            Failure(SOFTSHADOW_ERROR_INVALID, "the engine has no window (made by softshadow_engine_create_xlib)".into())
+        })?;
+        out(out_width, stats.width, "out_width")?;
+        out(out_height, stats.height, "out_height")
     })
 }
 

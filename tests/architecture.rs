@@ -25,6 +25,8 @@ const ROOMS: &[(&str, &[&str])] = &[
 const UNSAFE_ALLOWED: &[(&str, &str)] = &[
     ("renderer/mod.rs", "pub unsafe fn from_handles(handles: EmbedderHandles)"),
     ("renderer/mod.rs", "Engine::on(unsafe { Context::from_handles(handles) }?)"),
+    ("renderer/window.rs", "pub unsafe fn from_xlib("),
+    ("renderer/window.rs", "Engine::on(unsafe { Context::xlib(options, display, window) }?)"),
 ];
 
 /// The crate-level paths each file of `dir` imports, keyed by file.

@@ -3,21 +3,12 @@
 //! and the bad-calls program gets an error code and a message for each bad call (under
 //! valgrind, when installed, with definitely lost blocks of our code failing the test).
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::Command;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The folder cargo put `libsoftshadow.so` in: `cargo test` leaves it in `deps/`, beside the
-/// test binary; `cargo build` also copies it to the folder above.
-fn library_dir() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let deps = exe.parent().unwrap();
-    let found = [deps, deps.parent().unwrap()].into_iter().find(|d| d.join("libsoftshadow.so").exists());
-    found.unwrap_or_else(|| panic!("no libsoftshadow.so in {} or its parent", deps.display())).to_path_buf()
-}
+use common::c::{compile, passes, root};
 
 fn generated_header() -> String {
     let config = cbindgen::Config::from_file(root().join("cbindgen.toml")).unwrap();
@@ -30,18 +21,6 @@ fn generated_header() -> String {
         .expect("cbindgen reads src/ffi.rs")
         .write(&mut out);
     String::from_utf8(out).unwrap()
-}
-
-/// The `NAME MS` pairs a C program printed on lines starting with `prefix`.
-fn passes<'a>(stdout: &'a str, prefix: &str) -> Vec<(&'a str, f64)> {
-    stdout
-        .lines()
-        .filter_map(|l| l.strip_prefix(prefix))
-        .map(|l| {
-            let mut parts = l.split(' ');
-            (parts.next().unwrap(), parts.next().unwrap().parse().unwrap())
-        })
-        .collect()
 }
 
 /// A fresh generation equals include/softshadow.h; `SOFTSHADOW_BLESS=1` rewrites it instead.
@@ -61,30 +40,6 @@ fn the_checked_in_header_is_generated_from_the_code() {
     for rust_only in ["Vec<", "Option<", "&mut", "Box<", "Result<"] {
         assert!(!fresh.contains(rust_only), "a Rust type in the header: {rust_only}");
     }
-}
-
-/// Compiles `examples/c/NAME.c` with the system `cc` against the header and the shared library,
-/// and `libs` besides.
-fn compile(name: &str, libs: &[&str]) -> PathBuf {
-    let lib = library_dir();
-    let out = std::env::temp_dir().join(format!("softshadow-{name}-{}", std::process::id()));
-    let status = Command::new("cc")
-        .arg(root().join(format!("examples/c/{name}.c")))
-        .args(["-std=c11", "-Wall", "-Wextra", "-Werror", "-O1"])
-        .arg(format!("-I{}", root().join("include").display()))
-        .arg(format!("-L{}", lib.display()))
-        .arg(format!("-Wl,-rpath,{}", lib.display()))
-        // DT_RPATH, not RUNPATH: searched before LD_LIBRARY_PATH, where cargo puts target/debug
-        // and with it any older libsoftshadow.so a `cargo build` left there.
-        .arg("-Wl,--disable-new-dtags")
-        .args(["-lsoftshadow", "-lm"])
-        .args(libs)
-        .arg("-o")
-        .arg(&out)
-        .status()
-        .expect("the system C compiler `cc`");
-    assert!(status.success(), "cc failed on examples/c/{name}.c");
-    out
 }
 
 /// Reads a 16-bit binary PGM.

@@ -672,6 +672,73 @@ fn recorded_frames_are_timed_without_waiting() {
     e.finish();
 }
 
+/// Switching size and technique on the record path never waits for the queue (DESIGN.md §3: no
+/// device wait on this path): what a switch replaces lives on until the frames that used it can
+/// no longer run. Two frames stay in flight throughout, alternating between the embedder's
+/// 64 px depth with one technique and a 32 px depth (cleared: nothing but sky) with the other;
+/// validation with synchronization validation stays clean, and V after the switching matches V
+/// before it.
+#[test]
+fn switching_size_and_technique_while_recording_never_waits() {
+    let e = embedder();
+    let mut engine = engine_on(&e);
+    let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, false);
+    let s = scene(0.0);
+    let (smoothie, shadow_map) = (params("smoothie"), params("shadow-map"));
+    let shot = |params| Shot { scene: &s, params, camera: camera(true), box_x: 0.0 };
+    let before = frames.run(&e, &mut engine, &shot(&smoothie)).unwrap();
+    let waits = engine.context().queue_waits();
+
+    let small_extent = vk::Extent2D { width: SIDE / 2, height: SIDE / 2 };
+    let small =
+        e.image(vk::Format::D32_SFLOAT, small_extent, vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED);
+    const CLEARED: (vk::PipelineStageFlags2, vk::AccessFlags2, vk::ImageLayout) =
+        (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+    let fences = [e.fence(true), e.fence(true)];
+    let cmds = [e.command_buffer(), e.command_buffer()];
+    frames.own_target = true;
+    for i in 0..8 {
+        let cmd = cmds[i % 2];
+        // Frame i − 2 used this slot: wait for it, as the contract asks.
+        e.wait(fences[i % 2]);
+        e.begin(cmd);
+        if i % 2 == 0 {
+            let depth = vk::ImageAspectFlags::DEPTH;
+            barrier(&e.device, cmd, small.image, depth, UNDEFINED, CLEARED);
+            let range = [vk::ImageSubresourceRange {
+                aspect_mask: depth,
+                level_count: 1,
+                layer_count: 1,
+                ..Default::default()
+            }];
+            let far = vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 };
+            unsafe { e.device.cmd_clear_depth_stencil_image(cmd, small.image, CLEARED.2, &far, &range) };
+            let last = Access { stage: CLEARED.0, access: CLEARED.1, layout: CLEARED.2 };
+            let frame = EmbeddedFrame {
+                cmd,
+                camera: camera(true),
+                depth: EmbedderImage { image: small.image, format: small.format, extent: small_extent, last },
+                normal: None,
+                visibility: None,
+            };
+            engine.record(&s, &shadow_map, &frame).unwrap();
+        } else {
+            frames.record(&e, &mut engine, &shot(&smoothie), cmd).unwrap();
+        }
+        e.submit(cmd, fences[i % 2]);
+    }
+    fences.iter().for_each(|&f| unsafe { e.device.wait_for_fences(&[f], true, u64::MAX) }.unwrap());
+    assert_eq!(engine.context().queue_waits(), waits, "a record-path switch waited for the queue");
+    frames.own_target = false;
+    let after = frames.run(&e, &mut engine, &shot(&smoothie)).unwrap();
+    assert_eq!(differences(&before, &after, 0), (0, 0), "V after the switching");
+    fences.iter().for_each(|&f| unsafe { e.device.destroy_fence(f, None) });
+    e.destroy_image(small);
+    frames.destroy(&e);
+    drop(engine);
+    e.finish();
+}
+
 /// Recording again before the frame two records ago has finished is refused with a message
 /// saying so (the GPU is held on an event the host sets afterwards); once it has finished,
 /// recording works again.

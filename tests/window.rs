@@ -26,12 +26,13 @@ fn main() {
     let xvfb = common::xvfb::ensure_display();
     without_a_display_opening_a_window_names_the_variables();
     let mut app = AppWindow::open("softshadow window tests", W, H).expect("a window on the X server");
-    let checks: [(&str, Check); 6] = [
+    let checks: [(&str, Check); 7] = [
         ("a_moving_caster_is_presented_through_two_resizes", a_moving_caster_is_presented_through_two_resizes),
         ("a_presented_image_equals_the_headless_capture", a_presented_image_equals_the_headless_capture),
         ("the_present_mode_asked_for_is_taken", the_present_mode_asked_for_is_taken),
         ("fifo_keeps_the_cpu_within_the_frames_in_flight", fifo_keeps_the_cpu_within_the_frames_in_flight),
         ("softshadow_view_presents_and_writes_a_screenshot", softshadow_view_presents_and_writes_a_screenshot),
+        ("a_c_program_presents_into_its_own_xlib_window", a_c_program_presents_into_its_own_xlib_window),
         // Last: it brings a window manager, which then manages the window.
         ("minimising_under_a_window_manager_never_errors", minimising_under_a_window_manager_never_errors),
     ];
@@ -246,6 +247,29 @@ fn wait_for_state(app: &mut AppWindow, state: &str) {
         assert!(start.elapsed() < Duration::from_secs(10), "the window never became {state}: {:?}", wm_state(app));
         std::thread::sleep(Duration::from_millis(20));
     }
+}
+
+/// A C program opens its own Xlib window and hands `Display*` and `Window` to
+/// `softshadow_engine_create_xlib`: with validation on, every frame presents, at 96×64 and after
+/// the program shrinks the window to 48×32, no validation error is printed, and the last frame's
+/// passes have positive GPU times.
+fn a_c_program_presents_into_its_own_xlib_window(_: &mut AppWindow) {
+    let exe = common::c::compile("window_xlib", &["-lX11"]);
+    let output = std::process::Command::new(&exe)
+        .arg("scenes/default.toml")
+        .current_dir(common::c::root())
+        .output()
+        .expect("the C program runs");
+    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+    assert!(output.status.success(), "{stdout}\n{stderr}");
+    assert!(!stderr.contains("validation error"), "{stderr}");
+    for size in ["96x64", "48x32"] {
+        assert!(stdout.contains(&format!("window {size}: 30 of 30 frames presented at {size}")), "{stdout}");
+    }
+    let passes = common::c::passes(&stdout, "pass ");
+    assert!(!passes.is_empty() && passes.iter().all(|&(_, ms)| ms > 0.0), "{stdout}");
+    println!("  {}", stdout.lines().filter(|l| l.starts_with("pass ")).collect::<Vec<_>>().join(", "));
+    std::fs::remove_file(exe).unwrap();
 }
 
 /// Under a window manager (twm, started here; an X server's own one if it already has one),

@@ -70,6 +70,11 @@ int main(void) {
     EXPECT(softshadow_scene_load("scenes/default.toml", 64, NULL), SOFTSHADOW_ERROR_NULL);
     EXPECT(softshadow_scene_create(NULL, &scene), SOFTSHADOW_ERROR_NULL);
     EXPECT(softshadow_engine_create_from_vulkan(NULL, &engine), SOFTSHADOW_ERROR_NULL);
+    EXPECT(softshadow_engine_create_xlib(NULL, 1, 0, &engine), SOFTSHADOW_ERROR_NULL);
+    int not_a_display = 0; /* never read: a window of None is refused first */
+    EXPECT(softshadow_engine_create_xlib(&not_a_display, 0, 0, &engine), SOFTSHADOW_ERROR_INVALID);
+    EXPECT(softshadow_present(NULL, NULL, NULL), SOFTSHADOW_ERROR_NULL);
+    EXPECT(softshadow_window_size(NULL, NULL, NULL), SOFTSHADOW_ERROR_NULL);
     softshadow_vulkan no_device = {0};
     EXPECT(softshadow_engine_create_from_vulkan(&no_device, &engine), SOFTSHADOW_ERROR_NULL);
     /* Allocation callbacks without pfnFree: refused before any handle is used. */
@@ -133,6 +138,9 @@ int main(void) {
     EXPECT(softshadow_engine_set_knob(engine, "no_such_knob", 64, 1), SOFTSHADOW_ERROR_INVALID);
     EXPECT(softshadow_engine_set_knob(engine, "shadow_map_size", 64, 3), SOFTSHADOW_ERROR_INVALID);
     EXPECT(softshadow_engine_set_knob(engine, "shadow_map_size", 64, NAN), SOFTSHADOW_ERROR_INVALID);
+    uint32_t window_width = 0, window_height = 0;
+    EXPECT(softshadow_window_size(engine, &window_width, &window_height), SOFTSHADOW_ERROR_INVALID); /* no window */
+    EXPECT(softshadow_present(engine, scene, NULL), SOFTSHADOW_ERROR_INVALID);                      /* no window */
     EXPECT(softshadow_engine_set_size(engine, 0, 64), SOFTSHADOW_ERROR_INVALID);
     EXPECT(softshadow_engine_set_size(engine, 64, 1u << 30), SOFTSHADOW_ERROR_INVALID);
     softshadow_transform nan_transform = {.position = {0, NAN, 0}, .rotation_deg = {0, 0, 0}, .scale = {1, 1, 1}};

@@ -19,6 +19,7 @@
 #include <vulkan/vulkan.h>
 
 #include "softshadow.h"
+#include "check.h"
 
 #define SIDE 64
 #define FRAMES 8
@@ -27,17 +28,6 @@
 #define HALF 3.0f
 #define NEAR 1.0f
 #define FAR 20.0f
-
-#define CHECK(call)                                                                       \
-    do {                                                                                  \
-        softshadow_status status_ = (call);                                               \
-        if (status_ != SOFTSHADOW_OK) {                                                   \
-            char message_[512];                                                           \
-            softshadow_last_error(message_, sizeof message_);                             \
-            fprintf(stderr, "%s failed with status %d: %s\n", #call, (int)status_, message_); \
-            exit(1);                                                                      \
-        }                                                                                 \
-    } while (0)
 
 #define VK(call)                                                              \
     do {                                                                      \

@@ -13,21 +13,10 @@
 #include <string.h>
 
 #include "softshadow.h"
+#include "check.h"
 
 #define SIDE 64
 #define FRAMES 200
-
-/* Any failure: print the call, its status and the library's message, and stop. */
-#define CHECK(call)                                                                       \
-    do {                                                                                  \
-        softshadow_status status_ = (call);                                               \
-        if (status_ != SOFTSHADOW_OK) {                                                   \
-            char message_[512];                                                           \
-            softshadow_last_error(message_, sizeof message_);                             \
-            fprintf(stderr, "%s failed with status %d: %s\n", #call, (int)status_, message_); \
-            exit(1);                                                                      \
-        }                                                                                 \
-    } while (0)
 
 /* A unit cube about the origin: 8 corners, 12 triangles. */
 static const float CUBE[8 * 3] = {

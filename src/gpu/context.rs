@@ -4,7 +4,7 @@
 
 use std::ffi::{CStr, c_char};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -109,9 +109,25 @@ pub struct Context {
     // Boxed: the messenger holds a pointer to it. Dropped after the instance.
     log: Box<ValidationLog>,
     destroyed: bool,
+    retired: Mutex<Retired>,
+    /// `vkQueueWaitIdle` calls so far ([`Context::queue_waits`]).
+    queue_waits: AtomicU64,
     /// What the surface was made from, kept alive until the surface is destroyed.
     pub(super) window: Option<std::sync::Arc<dyn std::any::Any + Send + Sync>>,
 }
+
+/// Objects replaced while frames that used them may still run on the GPU, each with the number
+/// of frames recorded when it was replaced: destroyed once those frames cannot be in flight, so
+/// that replacing one never waits for the queue (an embedder's frame must not, DESIGN.md §3).
+#[derive(Default)]
+struct Retired {
+    /// Frames recorded so far: submitted, or recorded into the embedder's command buffer.
+    recorded: u64,
+    items: Vec<(u64, Destroyer)>,
+}
+
+/// Destroys one retired object.
+type Destroyer = Box<dyn FnOnce(&Context)>;
 
 /// What a constructor hands to `assemble`: the handles, and what was learned checking the device.
 struct Parts {
@@ -329,6 +345,8 @@ impl Context {
             info,
             log: parts.log,
             destroyed: false,
+            retired: Mutex::default(),
+            queue_waits: AtomicU64::new(0),
             window: None,
         };
         ctx.allocator = Some(Mutex::new(Allocator::new(&AllocatorCreateDesc {
@@ -431,7 +449,50 @@ impl Context {
         if self.destroyed {
             return Ok(()); // nothing can be in flight on a destroyed device
         }
+        self.queue_waits.fetch_add(1, Ordering::Relaxed);
         unsafe { self.device.queue_wait_idle(self.queue) }.vk("vkQueueWaitIdle")
+    }
+
+    /// How many times [`Context::wait_idle`] has waited: tests check that a path never does.
+    pub fn queue_waits(&self) -> u64 {
+        self.queue_waits.load(Ordering::Relaxed)
+    }
+
+    /// Runs `destroy` (of an object the frames recorded so far may use) once none of those
+    /// frames can still be in flight: [`FRAMES_IN_FLIGHT`](super::FRAMES_IN_FLIGHT) frames
+    /// later, or when the context is destroyed.
+    pub fn retire(&self, destroy: impl FnOnce(&Context) + 'static) {
+        let mut retired = self.retired.lock().expect("retire list");
+        let recorded = retired.recorded;
+        retired.items.push((recorded, Box::new(destroy)));
+    }
+
+    /// A frame has been recorded (submitted, or handed to the embedder to submit).
+    pub(super) fn frame_recorded(&self) {
+        self.retired.lock().expect("retire list").recorded += 1;
+    }
+
+    /// Destroys what was retired before the frames now known finished: called as frame n
+    /// begins, once its slot's previous frame (and so every frame up to n − FRAMES_IN_FLIGHT)
+    /// has finished. An object retired while frames up to m were recorded (m included, for one
+    /// replaced while recording frame m) goes when n ≥ m + FRAMES_IN_FLIGHT.
+    pub(super) fn destroy_finished(&self) {
+        let ready: Vec<_> = {
+            let mut retired = self.retired.lock().expect("retire list");
+            let n = retired.recorded;
+            let (ready, kept) = std::mem::take(&mut retired.items)
+                .into_iter()
+                .partition(|(at, _)| at + super::FRAMES_IN_FLIGHT as u64 <= n);
+            retired.items = kept;
+            ready
+        };
+        ready.into_iter().for_each(|(_, destroy)| destroy(self));
+    }
+
+    /// Destroys everything retired: only once the queue is idle.
+    pub(crate) fn destroy_retired(&self) {
+        let items = std::mem::take(&mut self.retired.lock().expect("retire list").items);
+        items.into_iter().for_each(|(_, destroy)| destroy(self));
     }
 
     /// Destroys our objects, then the device and instance if we own them; validation reports
@@ -444,6 +505,7 @@ impl Context {
         unsafe {
             // Nothing to do on failure: our objects are being torn down regardless.
             let _ = self.device.queue_wait_idle(self.queue);
+            self.destroy_retired();
             self.device.destroy_sampler(self.nearest_sampler, self.host_allocator());
             self.allocator = None;
             if self.ownership == Ownership::Owned {

@@ -112,6 +112,7 @@ impl FrameRing {
     pub fn begin(&mut self, ctx: &Context) -> Result<(Frame<'_>, Option<Vec<PassTime>>)> {
         let slot = self.next;
         let earlier = self.wait(ctx, slot)?;
+        ctx.destroy_finished();
         let s = &mut self.slots[slot];
         // The fence is reset only at submit: a frame abandoned on an error leaves it signalled,
         // so the next frame on this slot does not wait forever.
@@ -170,6 +171,7 @@ impl FrameRing {
                 }
             }
         }
+        ctx.destroy_finished();
         let s = &mut self.slots[slot];
         s.timer.reset(ctx, cmd);
         Ok((Frame { slot, cmd, timer: &mut s.timer }, done))
@@ -196,6 +198,7 @@ impl FrameRing {
         timer.submitted();
         external.pending[slot] = Some(mark);
         self.next = (slot + 1) % FRAMES_IN_FLIGHT;
+        ctx.frame_recorded();
     }
 
     /// Ends and submits the frame begun last, waiting on and signalling `semaphores`.
@@ -214,6 +217,7 @@ impl FrameRing {
         }
         s.timer.submitted();
         self.next = (slot + 1) % FRAMES_IN_FLIGHT;
+        ctx.frame_recorded();
         Ok(())
     }
 

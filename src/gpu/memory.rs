@@ -107,8 +107,9 @@ impl PerFrame {
         usage: vk::BufferUsageFlags,
     ) -> Result<&'a mut PerFrame> {
         if slot.as_ref().is_none_or(|b| b.capacity() < bytes) {
-            ctx.wait_idle()?;
-            slot.take().into_iter().for_each(|b| b.destroy(ctx));
+            if let Some(old) = slot.take() {
+                ctx.retire(move |ctx| old.destroy(ctx));
+            }
             *slot = Some(PerFrame::new(ctx, name, bytes.next_power_of_two(), super::FRAMES_IN_FLIGHT, usage)?);
         }
         Ok(slot.as_mut().expect("just ensured"))

@@ -79,6 +79,23 @@ impl Context {
         Ok(ctx)
     }
 
+    /// A context presenting to the embedder's Xlib `window` on `display`.
+    ///
+    /// # Safety
+    /// `display` is an open Xlib `Display*` and `window` a window on it; both outlive the context.
+    pub unsafe fn xlib(
+        options: &ContextOptions,
+        display: *mut std::ffi::c_void,
+        window: std::ffi::c_ulong,
+    ) -> Result<Context> {
+        let display =
+            std::ptr::NonNull::new(display).ok_or_else(|| Error::Invalid("the Xlib display is NULL".into()))?;
+        if window == 0 {
+            return Err(Error::Invalid("the Xlib window is None (0)".into()));
+        }
+        Context::windowed(options, Arc::new(XlibWindow { display, window }))
+    }
+
     fn surface(&self) -> Result<&(ash::khr::surface::Instance, vk::SurfaceKHR)> {
         self.surface.as_ref().ok_or_else(|| Error::Invalid("a swapchain needs a Context::windowed".into()))
     }
@@ -310,4 +327,36 @@ impl Swapchain {
 fn semaphore(ctx: &Context) -> Result<vk::Semaphore> {
     unsafe { ctx.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), ctx.host_allocator()) }
         .vk("vkCreateSemaphore")
+}
+
+/// A native Xlib window (`Display*`, `Window`), for the window handle traits that
+/// [`Context::windowed`] takes.
+struct XlibWindow {
+    display: std::ptr::NonNull<std::ffi::c_void>,
+    window: std::ffi::c_ulong,
+}
+
+// SAFETY: only handles (a pointer and an XID) the engine hands to Vulkan, which synchronises its
+// own use of the display.
+unsafe impl Send for XlibWindow {}
+unsafe impl Sync for XlibWindow {}
+
+impl raw_window_handle::HasDisplayHandle for XlibWindow {
+    fn display_handle(
+        &self,
+    ) -> std::result::Result<raw_window_handle::DisplayHandle<'_>, raw_window_handle::HandleError> {
+        let raw = raw_window_handle::XlibDisplayHandle::new(Some(self.display), 0);
+        // SAFETY: the embedder keeps the display open while the engine lives (Context::xlib's contract).
+        Ok(unsafe { raw_window_handle::DisplayHandle::borrow_raw(raw.into()) })
+    }
+}
+
+impl raw_window_handle::HasWindowHandle for XlibWindow {
+    fn window_handle(
+        &self,
+    ) -> std::result::Result<raw_window_handle::WindowHandle<'_>, raw_window_handle::HandleError> {
+        let raw = raw_window_handle::XlibWindowHandle::new(self.window);
+        // SAFETY: the embedder keeps the window alive while the engine lives (Context::xlib's contract).
+        Ok(unsafe { raw_window_handle::WindowHandle::borrow_raw(raw.into()) })
+    }
 }

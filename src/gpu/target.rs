@@ -275,8 +275,7 @@ pub fn ensure(ctx: &Context, slot: &mut Option<Target>, desc: TargetDesc) -> Res
     }
     if let Some(old) = slot.take() {
         // The old image may still be read by a frame in flight.
-        ctx.wait_idle()?;
-        old.destroy(ctx);
+        ctx.retire(move |ctx| old.destroy(ctx));
     }
     *slot = Some(Target::new(ctx, desc)?);
     Ok(())

@@ -268,7 +268,7 @@ impl Engine {
     /// # Safety
     /// As [`Context::from_handles`]: the handles must be valid, belong together and outlive the
     /// engine, and the queue must not be used from another thread while the engine waits on it
-    /// (when a frame's size or technique changes, and when it is dropped).
+    /// (when it is dropped).
     pub unsafe fn from_handles(handles: EmbedderHandles) -> Result<Self> {
         // SAFETY: the caller's promise, passed on.
         Engine::on(unsafe { Context::from_handles(handles) }?)
@@ -535,8 +535,9 @@ impl Engine {
     /// recording frame n it has waited for frame n − 2 to finish (an error says so otherwise),
     /// and it submits every frame it records. Pass times arrive in [`Engine::take_timings`] as
     /// soon as a later `record` finds them written: one frame late when the GPU keeps up. A
-    /// change of size or technique since the last frame waits for the queue once
-    /// (`vkQueueWaitIdle`). On an error the command buffer may hold part of the frame: reset it.
+    /// change of size or technique since the last frame never waits: what it replaces is
+    /// destroyed [`FRAMES_IN_FLIGHT`] frames later ([`Context::retire`]), or when the engine is
+    /// dropped. On an error the command buffer may hold part of the frame: reset it.
     /// Offline CPU techniques (`raytrace`, `parker`) cannot record and are refused.
     pub fn record(&mut self, scene: &Scene, params: &Params, frame: &EmbeddedFrame) -> Result<Recorded> {
         scene.validate()?;
@@ -610,8 +611,7 @@ impl Engine {
             return Ok(());
         }
         if let Some(old) = self.targets.take() {
-            self.ctx.wait_idle()?;
-            old.destroy(&self.ctx);
+            self.ctx.retire(move |ctx| old.destroy(ctx));
         }
         self.targets = Some(CameraTargets::new(&self.ctx, w, h, self.visibility_format)?);
         Ok(())
@@ -622,8 +622,7 @@ impl Engine {
             return Ok(());
         }
         if let Some((_, old)) = self.technique.take() {
-            self.ctx.wait_idle()?;
-            old.destroy(&self.ctx);
+            self.ctx.retire(move |ctx| old.destroy(ctx));
         }
         self.technique = Some((info.name, info.create(&self.ctx, self.visibility_format)?));
         Ok(())
@@ -633,6 +632,7 @@ impl Engine {
         let ctx = &self.ctx;
         // Nothing more can fail usefully here; the device is going away.
         let _ = ctx.wait_idle();
+        ctx.destroy_retired();
         if let Some((_, t)) = self.technique.take() {
             t.destroy(ctx);
         }

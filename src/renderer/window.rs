@@ -48,9 +48,18 @@ pub struct WindowStats {
     pub skipped_frames: u64,
 }
 
+/// Where a presenter learns the window's size each frame.
+enum Size {
+    /// A winit window: its inner size.
+    Winit(Arc<Window>),
+    /// A native X11 window the embedder owns: the surface's current extent, which X11 keeps
+    /// equal to the window's size.
+    Surface,
+}
+
 /// A window's swapchain and the composite for its format.
 pub(super) struct Presenter {
-    window: Arc<Window>,
+    window: Size,
     request: WindowOptions,
     /// `None` until the window first has an area.
     swapchain: Option<Swapchain>,
@@ -64,7 +73,7 @@ pub(super) struct Presenter {
 }
 
 impl Presenter {
-    fn new(window: Arc<Window>, request: WindowOptions) -> Self {
+    fn new(window: Size, request: WindowOptions) -> Self {
         let stats = WindowStats {
             format: vk::Format::UNDEFINED,
             present_mode: vk::PresentModeKHR::FIFO,
@@ -88,19 +97,24 @@ impl Presenter {
 
     /// The swapchain's size once it matches the window, `None` while the window has no area.
     fn prepare(&mut self, ctx: &Context) -> Result<Option<vk::Extent2D>> {
-        let size = self.window.inner_size();
-        let current = self.swapchain.as_ref().filter(|_| !self.stale && size == self.made_for);
-        if let Some(swapchain) = current {
-            return Ok(Some(swapchain.extent()));
-        }
-        if size.width == 0 || size.height == 0 || ctx.surface_extent()?.is_none() {
-            self.stats.skipped_frames += 1;
-            return Ok(None);
-        }
+        let size = match &self.window {
+            Size::Winit(window) => window.inner_size(),
+            Size::Surface => {
+                ctx.surface_extent()?.map_or(PhysicalSize::default(), |e| PhysicalSize::new(e.width, e.height))
+            }
+        };
+        let made_for = self.swapchain.as_ref().map(|_| self.made_for);
+        let extent = match step(made_for, self.stale, size, || ctx.surface_extent())? {
+            Step::Reuse => return Ok(Some(self.swapchain.as_ref().expect("made").extent())),
+            Step::Skip => {
+                self.stats.skipped_frames += 1;
+                return Ok(None);
+            }
+            Step::Make(extent) => extent,
+        };
         let start = Instant::now();
         // Frames in flight may still use the old images and semaphores.
         ctx.wait_idle()?;
-        let extent = vk::Extent2D { width: size.width, height: size.height };
         let swapchain = match &mut self.swapchain {
             Some(swapchain) => {
                 swapchain.recreate(ctx, extent)?;
@@ -179,6 +193,36 @@ impl Presenter {
     }
 }
 
+/// What a frame does with the swapchain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Step {
+    /// The swapchain was made for the window's size and is still valid: render into it.
+    Reuse,
+    /// The window or its surface has no area (minimised): skip the frame, without error.
+    Skip,
+    /// Make the swapchain (again) at this size, then render.
+    Make(vk::Extent2D),
+}
+
+/// The decision before each frame, from the window size the swapchain was made for (`None`
+/// before there is one), whether the surface has changed since (`stale`), the window's size
+/// now, and the surface's current extent (`None` when it has no area), asked only when the
+/// swapchain cannot be reused.
+fn step(
+    made_for: Option<PhysicalSize<u32>>,
+    stale: bool,
+    window: PhysicalSize<u32>,
+    surface: impl FnOnce() -> Result<Option<vk::Extent2D>>,
+) -> Result<Step> {
+    if !stale && made_for == Some(window) {
+        return Ok(Step::Reuse);
+    }
+    if window.width == 0 || window.height == 0 || surface()?.is_none() {
+        return Ok(Step::Skip);
+    }
+    Ok(Step::Make(vk::Extent2D { width: window.width, height: window.height }))
+}
+
 /// Formats whose presented images can be read back as RGBA8.
 const READABLE: [vk::Format; 5] = [
     vk::Format::B8G8R8A8_SRGB,
@@ -193,7 +237,25 @@ impl Engine {
     /// present, with a swapchain made when the window first has an area.
     pub fn windowed(options: &ContextOptions, window: Arc<Window>, request: WindowOptions) -> Result<Self> {
         let mut engine = Engine::on(Context::windowed(options, window.clone())?)?;
-        engine.window = Some(Presenter::new(window, request));
+        engine.window = Some(Presenter::new(Size::Winit(window), request));
+        Ok(engine)
+    }
+
+    /// An engine presenting to the embedder's Xlib `window` on `display` (the C ABI's
+    /// `softshadow_engine_create_xlib`), at the window's size, which it reads from the surface
+    /// each frame.
+    ///
+    /// # Safety
+    /// `display` is an open Xlib `Display*` and `window` a window on it; both outlive the engine.
+    pub unsafe fn from_xlib(
+        options: &ContextOptions,
+        display: *mut std::ffi::c_void,
+        window: std::ffi::c_ulong,
+        request: WindowOptions,
+    ) -> Result<Self> {
+        // SAFETY: the caller's contract, passed on.
+        let mut engine = Engine::on(unsafe { Context::xlib(options, display, window) }?)?;
+        engine.window = Some(Presenter::new(Size::Surface, request));
         Ok(engine)
     }
 
@@ -322,4 +384,50 @@ impl AppWindow {
 
 fn display() -> String {
     std::env::var("DISPLAY").unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A window's frames through minimising and restoring, as [`Presenter::prepare`] drives
+    /// [`step`]: frames are skipped, never an error, while the window or its surface has no area,
+    /// and resume after; restored at the size it had, the swapchain is reused, not re-made.
+    #[test]
+    fn frames_skip_while_the_surface_has_no_area_and_resume_after() {
+        let size = |w, h| PhysicalSize::new(w, h);
+        let extent = |width, height| Some(vk::Extent2D { width, height });
+        // (window size, stale, the surface's current extent, the step expected)
+        let frames = [
+            (size(64, 48), false, extent(64, 48), Step::Make(vk::Extent2D { width: 64, height: 48 })),
+            (size(64, 48), false, None, Step::Reuse),
+            // A surface that takes the swapchain's size (Wayland): the window decides.
+            (size(0, 0), false, extent(u32::MAX, u32::MAX), Step::Skip),
+            (size(64, 0), false, extent(u32::MAX, u32::MAX), Step::Skip),
+            // Iconified under X: the window keeps its size, the surface may say it has none.
+            (size(64, 48), true, None, Step::Skip),
+            (size(64, 48), false, None, Step::Reuse),
+            (size(1, 1), false, extent(1, 1), Step::Make(vk::Extent2D { width: 1, height: 1 })),
+            (size(0, 0), true, None, Step::Skip),
+            (size(32, 32), false, extent(32, 32), Step::Make(vk::Extent2D { width: 32, height: 32 })),
+        ];
+        let mut made_for = None;
+        let mut skipped = 0;
+        for (n, (window, stale, surface, expected)) in frames.into_iter().enumerate() {
+            let got = step(made_for, stale, window, || Ok(surface)).unwrap();
+            assert_eq!(got, expected, "frame {n}: window {window:?}, stale {stale}, surface {surface:?}");
+            match got {
+                Step::Make(_) => made_for = Some(window),
+                Step::Skip => skipped += 1,
+                Step::Reuse => {}
+            }
+        }
+        assert_eq!(skipped, 4);
+    }
+
+    #[test]
+    fn a_failing_surface_query_is_an_error_not_a_skip() {
+        let failed = || Err(Error::Invalid("surface lost".into()));
+        assert!(step(None, false, PhysicalSize::new(8, 8), failed).is_err());
+    }
 }

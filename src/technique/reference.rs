@@ -174,8 +174,8 @@ impl Technique for Reference {
         let batches = samples.len().div_ceil(per_batch) as u32;
         if self.milestones.first().is_none_or(|m| m.capacity() < batches) {
             // Grows only; the old pools may still be written by the frame in flight.
-            ctx.wait_idle()?;
-            std::mem::take(&mut self.milestones).into_iter().for_each(|m| m.destroy(ctx));
+            let old = std::mem::take(&mut self.milestones);
+            ctx.retire(move |ctx| old.into_iter().for_each(|m| m.destroy(ctx)));
             for _ in 0..FRAMES_IN_FLIGHT {
                 self.milestones.push(Milestones::new(ctx, batches)?);
             }

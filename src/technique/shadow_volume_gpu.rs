@@ -157,8 +157,9 @@ impl GpuVolumes {
         write(ctx, &mut self.commands, frame.slot, "volume draws", usage, &commands)?;
         let bytes = (end.max(1) as u64 * VERTEX_BYTES).next_power_of_two();
         if self.vertices.as_ref().is_none_or(|v| v.range().range < bytes) {
-            ctx.wait_idle()?;
-            self.vertices.take().into_iter().for_each(|v| v.destroy(ctx));
+            if let Some(old) = self.vertices.take() {
+                ctx.retire(move |ctx| old.destroy(ctx));
+            }
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER;
             self.vertices = Some(Buffer::new(ctx, "gpu shadow volumes", bytes, usage, MemoryLocation::GpuOnly)?);
         }

@@ -267,9 +267,8 @@ impl Technique for Smoothie {
         let ctx = frame.ctx;
         let format = if params.is_on(&DEPTH16) { vk::Format::R16_SFLOAT } else { DEPTH_FORMAT };
         if self.pass.format() != format {
-            ctx.wait_idle()?;
             let old = std::mem::replace(&mut self.pass, ShadowMapPass::new(ctx, format)?);
-            old.destroy(ctx);
+            ctx.retire(move |ctx| old.destroy(ctx));
         }
         let size = params.get(&MAP_SIZE) as u32;
         let buffer_size = params.get(&SMOOTHIE_SIZE) as u32;

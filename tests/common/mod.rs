@@ -2,6 +2,7 @@
 //! on, and a test fails on any validation error, including objects left alive at exit.
 #![allow(dead_code)] // each test binary uses a different subset of these helpers
 
+pub mod c;
 pub mod embedder;
 pub mod xvfb;
 

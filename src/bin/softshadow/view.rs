@@ -231,7 +231,13 @@ pub fn view(args: &ViewArgs) -> Result<()> {
             engine.present(&scene, &params)?;
         }
         if compare {
-            compare_with_reference(&mut engine, &scene, &params)?;
+            let stats = engine.window_stats().context("a windowed engine")?;
+            let (width, height) = (stats.width, stats.height);
+            let m = compare_with_reference(&mut engine, &scene, &params, width, height)?;
+            println!(
+                "{} against the reference at {width}x{height}: RMSE {:.4}, penumbra RMSE {:.4}, max {:.3}",
+                params.technique.name, m.rmse, m.penumbra_rmse, m.max_abs
+            );
         }
         for t in engine.take_timings() {
             if recent.len() == MEDIAN_FRAMES {
@@ -290,20 +296,19 @@ fn save_screenshot(capture: &Capture, report: &TimingReport, stem: &str) -> Resu
     Ok(())
 }
 
-/// Renders the technique and the GPU reference for the current view offscreen, and prints the
-/// technique's error.
-fn compare_with_reference(engine: &mut Engine, scene: &Scene, params: &Params) -> Result<()> {
-    let stats = engine.window_stats().context("a windowed engine")?;
-    let (width, height) = (stats.width, stats.height);
+/// Renders the technique and the GPU reference for the current view offscreen at the window's
+/// size, and returns the technique's error against the reference.
+fn compare_with_reference(
+    engine: &mut Engine,
+    scene: &Scene,
+    params: &Params,
+    width: u32,
+    height: u32,
+) -> Result<Metrics> {
     let ours = engine.render_and_capture(scene, &FrameSettings { width, height, params: params.clone() })?;
     let truth = Params::defaults(ground_truth(Runs::Gpu));
     let truth = engine.render_and_capture(scene, &FrameSettings { width, height, params: truth })?;
-    let m = Metrics::between(&ours, &truth)?;
-    println!(
-        "{} against the reference at {width}x{height}: RMSE {:.4}, penumbra RMSE {:.4}, max {:.3}",
-        params.technique.name, m.rmse, m.penumbra_rmse, m.max_abs
-    );
-    Ok(())
+    Ok(Metrics::between(&ours, &truth)?)
 }
 
 #[cfg(test)]
@@ -453,5 +458,60 @@ mod tests {
         let quit = feed(&mut c, &mut scene, &mut params, &t, &[Input::Key(Key::Named(NamedKey::Escape))]);
         assert!(quit.quit);
         assert!(feed(&mut c, &mut scene, &mut params, &t, &[Input::Close]).quit);
+    }
+
+    fn validated_engine() -> Engine {
+        Engine::headless(&ContextOptions { validation: true, device: None }).expect("a Vulkan device (lavapipe)")
+    }
+
+    fn no_validation_errors(engine: Engine) {
+        let errors = engine.finish();
+        assert!(errors.is_empty(), "validation: {errors:?}");
+    }
+
+    /// What S writes (the key's request is checked above), for a frame of the default scene:
+    /// the colour PNG, V as a 16-bit grey PNG equal to the frame's V, and the timings JSON naming
+    /// the technique and the frame's size.
+    #[test]
+    fn the_screenshot_writes_color_visibility_and_timings() {
+        let (_, scene, params, _) = setup();
+        let mut engine = validated_engine();
+        let settings = FrameSettings { width: 64, height: 48, params };
+        let capture = engine.render_and_capture(&scene, &settings).unwrap();
+        engine.flush().unwrap();
+        let timings = engine.take_timings();
+        let dir = std::env::temp_dir().join(format!("softshadow-view-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let stem = dir.join("shot");
+        let stem = stem.to_str().unwrap();
+        save_screenshot(&capture, &report(&engine, &settings.params, &capture, &timings), stem).unwrap();
+
+        let color = image::open(format!("{stem}.png")).unwrap();
+        assert_eq!((color.width(), color.height()), (64, 48));
+        assert_eq!(color.to_rgba8().into_raw(), capture.color, "the colour PNG is the frame");
+        let v = image::open(format!("{stem}-visibility.png")).unwrap();
+        let v = v.as_luma16().expect("V is 16-bit grey");
+        assert_eq!(v.as_raw(), &capture.visibility, "the V PNG is the frame's V");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(format!("{stem}-timings.json")).unwrap()).unwrap();
+        assert_eq!(json["technique"], "pcss", "{json}");
+        assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(64), Some(48)), "{json}");
+        std::fs::remove_dir_all(&dir).unwrap();
+        no_validation_errors(engine);
+    }
+
+    /// What R computes: the reference against itself has no error; a hard shadow map, which has
+    /// no penumbra, has some, in the penumbrae above all.
+    #[test]
+    fn the_comparison_measures_the_error_against_the_reference() {
+        let (_, scene, _, _) = setup();
+        let mut engine = validated_engine();
+        let truth = Params::defaults(ground_truth(Runs::Gpu));
+        let m = compare_with_reference(&mut engine, &scene, &truth, 64, 64).unwrap();
+        assert_eq!((m.rmse, m.penumbra_rmse, m.max_abs), (0.0, 0.0, 0.0), "the reference against itself");
+        let hard = Params::defaults(find("shadow-map").unwrap());
+        let m = compare_with_reference(&mut engine, &scene, &hard, 64, 64).unwrap();
+        assert!(m.rmse > 0.0 && m.penumbra_rmse > m.rmse, "a hard shadow: {m:?}");
+        no_validation_errors(engine);
     }
 }
