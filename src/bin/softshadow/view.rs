@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result};
 use glam::Vec3;
 use softshadow::gpu::ContextOptions;
-use softshadow::measure::{Metrics, TimingReport};
+use softshadow::measure::{FileTrace, Metrics, TimingReport};
 use softshadow::scene::Scene;
 use softshadow::technique::registry::ground_truth;
 use softshadow::technique::{Kind, Params, Runs, TECHNIQUES, TechniqueInfo};
@@ -18,7 +18,7 @@ use winit::keyboard::{Key, ModifiersState, NamedKey};
 
 /// What the keys do, printed at start.
 const KEYS: &str = "Tab: next technique, [ ]: light radius, - +: the technique's first knob, \
-                    S: screenshot, R: error against the reference, Esc: quit";
+                    S: screenshot (colour, V, timings, trace), R: error against the reference, Esc: quit";
 
 /// Frames the title's per-pass medians are taken over.
 const MEDIAN_FRAMES: usize = 60;
@@ -224,7 +224,7 @@ pub fn view(args: &ViewArgs) -> Result<()> {
                 (Some(path), true) => capture.save_color(path)?,
                 _ => {
                     shots += 1;
-                    save_screenshot(&capture, &report, &format!("softshadow-view-{shots}"))?;
+                    save_screenshot(&capture, &report, recent.make_contiguous(), &format!("softshadow-view-{shots}"))?;
                 }
             }
         } else {
@@ -286,13 +286,17 @@ fn title(engine: &Engine, params: &Params, frames: &[FrameTimings]) -> String {
     format!("{}{knob}: {:.2} GPU ms ({}) {w}x{h}", params.technique.name, r.gpu_ms_total_median, passes.join(", "))
 }
 
-/// Color, 16-bit V and timings JSON, named after `stem`.
-fn save_screenshot(capture: &Capture, report: &TimingReport, stem: &str) -> Result<()> {
+/// Color, 16-bit V, timings JSON and a Chrome trace of the recent `frames` (the ones `report`
+/// summarises), named after `stem`.
+fn save_screenshot(capture: &Capture, report: &TimingReport, frames: &[FrameTimings], stem: &str) -> Result<()> {
     let color = PathBuf::from(format!("{stem}.png"));
     capture.save_color(&color)?;
     capture.save_visibility(Path::new(&format!("{stem}-visibility.png")))?;
     super::write_json(report, Path::new(&format!("{stem}-timings.json")))?;
-    println!("wrote {} and its V and timings", color.display());
+    let mut trace = FileTrace::create(&report.device, Path::new(&format!("{stem}-trace.json")))?;
+    trace.add_frames(frames, &serde_json::json!({ "technique": report.technique }));
+    trace.finish()?;
+    println!("wrote {} and its V, timings and trace", color.display());
     Ok(())
 }
 
@@ -470,8 +474,8 @@ mod tests {
     }
 
     /// What S writes (the key's request is checked above), for a frame of the default scene:
-    /// the colour PNG, V as a 16-bit grey PNG equal to the frame's V, and the timings JSON naming
-    /// the technique and the frame's size.
+    /// the colour PNG, V as a 16-bit grey PNG equal to the frame's V, the timings JSON naming
+    /// the technique and the frame's size, and a Chrome trace of the frame's passes.
     #[test]
     fn the_screenshot_writes_color_visibility_and_timings() {
         let (_, scene, params, _) = setup();
@@ -484,7 +488,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let stem = dir.join("shot");
         let stem = stem.to_str().unwrap();
-        save_screenshot(&capture, &report(&engine, &settings.params, &capture, &timings), stem).unwrap();
+        save_screenshot(&capture, &report(&engine, &settings.params, &capture, &timings), &timings, stem).unwrap();
 
         let color = image::open(format!("{stem}.png")).unwrap();
         assert_eq!((color.width(), color.height()), (64, 48));
@@ -496,6 +500,18 @@ mod tests {
             serde_json::from_str(&std::fs::read_to_string(format!("{stem}-timings.json")).unwrap()).unwrap();
         assert_eq!(json["technique"], "pcss", "{json}");
         assert_eq!((json["width"].as_u64(), json["height"].as_u64()), (Some(64), Some(48)), "{json}");
+        // The trace holds the frame's GPU passes, each named and timed, on the GPU track.
+        let trace: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(format!("{stem}-trace.json")).unwrap()).unwrap();
+        let gpu: Vec<&str> = trace["traceEvents"]
+            .as_array()
+            .expect("Chrome trace events")
+            .iter()
+            .filter(|e| e["cat"] == "gpu")
+            .filter_map(|e| e["name"].as_str())
+            .collect();
+        let passes: Vec<&str> = timings.iter().flat_map(|t| t.passes.iter().map(|p| p.name)).collect();
+        assert!(!passes.is_empty() && gpu == passes, "trace {gpu:?}, frames {passes:?}");
         std::fs::remove_dir_all(&dir).unwrap();
         no_validation_errors(engine);
     }
