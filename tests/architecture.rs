@@ -114,6 +114,21 @@ fn only_gpu_calls_vulkan() {
     }
 }
 
+/// Only the frame submits work (DESIGN.md §3: an embedder's frame is the only one, and nothing
+/// of the engine's waits on the queue behind it): every upload is recorded into a frame.
+#[test]
+fn only_frames_submit() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = BTreeMap::new();
+    imports(&src, &mut files);
+    let submitting: Vec<_> = files
+        .keys()
+        .filter(|f| std::fs::read_to_string(f).unwrap().contains("queue_submit"))
+        .map(|f| f.trim_start_matches(src.to_str().unwrap()).to_string())
+        .collect();
+    assert_eq!(submitting, ["/gpu/frames.rs"], "files that submit to the queue");
+}
+
 /// The C ABI dereferences C pointers (its `unsafe`), but calls Vulkan only through the engine.
 #[test]
 fn the_c_abi_calls_no_vulkan_itself() {

@@ -467,6 +467,12 @@ impl Context {
         retired.items.push((recorded, Box::new(destroy)));
     }
 
+    /// Frames recorded so far (submitted, or recorded into the embedder's command buffer): a
+    /// frame that fails before then does not count.
+    pub fn frames_recorded(&self) -> u64 {
+        self.retired.lock().expect("retire list").recorded
+    }
+
     /// A frame has been recorded (submitted, or handed to the embedder to submit).
     pub(super) fn frame_recorded(&self) {
         self.retired.lock().expect("retire list").recorded += 1;

@@ -35,4 +35,4 @@ pub use render::{
 pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
-pub use upload::{copy_to_buffer, copy_to_target, upload, upload_in};
+pub use upload::{Uploads, copy_to_buffer, copy_to_target, upload, upload_in};

@@ -1,5 +1,5 @@
-//! One-time uploads of static data (meshes) into device-local buffers, per-frame copies of
-//! CPU-computed images into targets, and copies of targets out for readback.
+//! Uploads of static data (meshes) into device-local buffers, recorded into a frame; per-frame
+//! copies of CPU-computed images into targets; copies of targets out for readback.
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -8,22 +8,64 @@ use super::Context;
 use super::barrier::{Access, transition};
 use super::memory::Buffer;
 use super::target::Target;
-use crate::error::{Result, VkContext};
+use crate::error::Result;
 
-/// Creates a device-local buffer holding `bytes`, through a staging buffer, and waits for it.
-pub fn upload(ctx: &Context, name: &str, bytes: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
-    let mut made = None;
-    let result = submit_and_wait(ctx, |cmd| {
-        made = Some(upload_in(ctx, cmd, name, bytes, usage));
-    });
-    let (dst, staging) = made.expect("recorded")?;
-    staging.destroy(ctx);
-    match result {
-        Ok(()) => Ok(dst),
-        Err(e) => {
-            dst.destroy(ctx);
-            Err(e)
+/// Creates a device-local buffer holding `bytes`, its copy from a staging buffer recorded into
+/// `cmd` (the frame's: no submission of its own, so an embedder's frame stays the only one), the
+/// staging buffer retired until the frames recorded so far are done.
+pub fn upload(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    name: &str,
+    bytes: &[u8],
+    usage: vk::BufferUsageFlags,
+) -> Result<Buffer> {
+    let (dst, staging) = upload_in(ctx, cmd, name, bytes, usage)?;
+    ctx.retire(move |ctx| staging.destroy(ctx));
+    Ok(dst)
+}
+
+/// Data uploaded by recording into frames ([`upload`]), by key. A frame that fails before it is
+/// recorded never runs its copies: what it uploaded is retired at the next frame, and made again
+/// when asked for.
+pub struct Uploads<K, T> {
+    /// Key, the frames recorded when it was uploaded, and the data.
+    items: Vec<(K, u64, T)>,
+    destroy: fn(T, &Context),
+}
+
+impl<K: PartialEq, T: 'static> Uploads<K, T> {
+    pub fn new(destroy: fn(T, &Context)) -> Self {
+        Uploads { items: Vec::new(), destroy }
+    }
+
+    /// Once a frame, before its uploads: forgets what a frame that was never recorded uploaded.
+    pub fn begin_frame(&mut self, ctx: &Context) {
+        let recorded = ctx.frames_recorded();
+        let destroy = self.destroy;
+        let (lost, kept): (Vec<_>, Vec<_>) =
+            std::mem::take(&mut self.items).into_iter().partition(|(_, at, _)| *at == recorded);
+        self.items = kept;
+        // An embedder may have submitted the failed frame's command buffer all the same.
+        lost.into_iter().for_each(|(_, _, data)| ctx.retire(move |ctx| destroy(data, ctx)));
+    }
+
+    /// The index of `key`'s data, made by `make` (recording its upload into this frame) when
+    /// absent.
+    pub fn index(&mut self, ctx: &Context, key: K, make: impl FnOnce() -> Result<T>) -> Result<usize> {
+        if let Some(at) = self.items.iter().position(|(k, _, _)| *k == key) {
+            return Ok(at);
         }
+        self.items.push((key, ctx.frames_recorded(), make()?));
+        Ok(self.items.len() - 1)
+    }
+
+    pub fn get(&self, index: usize) -> &T {
+        &self.items[index].2
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.items.into_iter().for_each(|(_, _, data)| (self.destroy)(data, ctx));
     }
 }
 
@@ -74,37 +116,6 @@ pub fn upload_in(
         ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
     }
     Ok((dst, staging))
-}
-
-fn submit_and_wait(ctx: &Context, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
-    let d = &ctx.device;
-    let pool_ci = vk::CommandPoolCreateInfo::default()
-        .queue_family_index(ctx.queue_family)
-        .flags(vk::CommandPoolCreateFlags::TRANSIENT);
-    let pool = unsafe { d.create_command_pool(&pool_ci, ctx.host_allocator()) }.vk("vkCreateCommandPool")?;
-    let run = || -> Result<()> {
-        let alloc = vk::CommandBufferAllocateInfo::default()
-            .command_pool(pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        let cmd = unsafe { d.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
-        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-        unsafe { d.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
-        record(cmd);
-        unsafe { d.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
-        let fence =
-            unsafe { d.create_fence(&vk::FenceCreateInfo::default(), ctx.host_allocator()) }.vk("vkCreateFence")?;
-        let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-        let waited = unsafe { d.queue_submit2(ctx.queue, &submit, fence) }
-            .vk("vkQueueSubmit2")
-            .and_then(|()| unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.vk("vkWaitForFences"));
-        unsafe { d.destroy_fence(fence, ctx.host_allocator()) };
-        waited
-    };
-    let result = run();
-    unsafe { d.destroy_command_pool(pool, ctx.host_allocator()) };
-    result
 }
 
 /// Records a copy of tightly packed texels from `src` (a host-visible range written this frame)

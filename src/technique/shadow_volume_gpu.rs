@@ -16,8 +16,8 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::VolumeParams;
 use crate::geometry::NO_FACE;
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, PerFrame, Pipeline, buffer_barrier, dispatch, draw_indirect, shaders,
-    upload,
+    Buffer, BufferAccess, Context, Descriptor, PerFrame, Pipeline, Uploads, buffer_barrier, dispatch, draw_indirect,
+    shaders, upload,
 };
 use crate::scene::{Mesh, MeshId};
 
@@ -42,14 +42,15 @@ struct MeshData {
 }
 
 impl MeshData {
-    fn new(ctx: &Context, mesh: &Mesh) -> Result<Self> {
+    /// The mesh's data, its upload recorded into `cmd`.
+    fn new(ctx: &Context, cmd: vk::CommandBuffer, mesh: &Mesh) -> Result<Self> {
         let edges = &mesh.adjacency.edges;
         let mut data: Vec<[u32; 4]> = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 0.0].map(f32::to_bits)).collect();
         let triangles_at = data.len() as u32;
         data.extend(mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]));
         let edges_at = data.len() as u32;
         data.extend(edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]));
-        let buffer = upload(ctx, "volume mesh", cast_slice(&data), vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        let buffer = upload(ctx, cmd, "volume mesh", cast_slice(&data), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         // An edge is extruded once per face on it, at most; a triangle gives a dark and a light
         // cap, or a dark and a turned one.
         let faces: u32 = edges.iter().map(|e| e.faces.iter().filter(|&&f| f != NO_FACE).count() as u32).sum();
@@ -76,7 +77,7 @@ struct Dispatch {
 
 pub struct GpuVolumes {
     pipeline: Pipeline,
-    meshes: Vec<(MeshId, MeshData)>,
+    meshes: Uploads<MeshId, MeshData>,
     params: Option<PerFrame>,
     commands: Option<PerFrame>,
     vertices: Option<Buffer>,
@@ -89,7 +90,7 @@ impl GpuVolumes {
         let pipeline = Pipeline::compute(ctx, "silhouettes", &shaders::SHADOW_VOLUME_SILHOUETTES_COMP, &[])?;
         Ok(GpuVolumes {
             pipeline,
-            meshes: Vec::new(),
+            meshes: Uploads::new(|m, ctx| m.buffer.destroy(ctx)),
             params: None,
             commands: None,
             vertices: None,
@@ -105,16 +106,12 @@ impl GpuVolumes {
         let ctx = frame.ctx;
         self.dispatches.clear();
         self.groups = groups.len();
+        // A frame that was never recorded ran none of its uploads.
+        self.meshes.begin_frame(ctx);
         for (g, group) in groups.iter().enumerate() {
             for &(object, two_sided) in group {
                 let mesh = &frame.scene.objects[object].mesh;
-                let at = match self.meshes.iter().position(|(id, _)| *id == mesh.id()) {
-                    Some(at) => at,
-                    None => {
-                        self.meshes.push((mesh.id(), MeshData::new(ctx, mesh)?));
-                        self.meshes.len() - 1
-                    }
-                };
+                let at = self.meshes.index(ctx, mesh.id(), || MeshData::new(ctx, frame.cmd, mesh))?;
                 self.dispatches.push(Dispatch { mesh: at, object, group: g, two_sided });
             }
         }
@@ -127,7 +124,7 @@ impl GpuVolumes {
                     .dispatches
                     .iter()
                     .filter(|d| d.group == g && (k < 2 || d.two_sided))
-                    .map(|d| self.meshes[d.mesh].1.most[k])
+                    .map(|d| self.meshes.get(d.mesh).most[k])
                     .sum();
                 *part = (end, end + most);
                 end += most;
@@ -138,7 +135,7 @@ impl GpuVolumes {
         let mut params = Vec::with_capacity(points.len() * self.dispatches.len());
         for (p, q) in points.iter().enumerate() {
             for d in &self.dispatches {
-                let (mesh, object) = (&self.meshes[d.mesh].1, &frame.scene.objects[d.object]);
+                let (mesh, object) = (&self.meshes.get(d.mesh), &frame.scene.objects[d.object]);
                 let command = |k: usize| ((p * groups.len() + d.group) * PARTS + k) as u32;
                 let [sides, caps, turned] = ranges[d.group];
                 params.push(VolumeParams {
@@ -175,7 +172,7 @@ impl GpuVolumes {
         // The previous point's draws, or an earlier frame's, read the same vertices.
         buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::COMPUTE_READ_WRITE);
         for (i, d) in self.dispatches.iter().enumerate() {
-            let mesh = &self.meshes[d.mesh].1;
+            let mesh = &self.meshes.get(d.mesh);
             let one = vk::DescriptorBufferInfo {
                 buffer: params.buffer,
                 offset: params.offset + (p * self.dispatches.len() + i) as u64 * PARAMS_BYTES,
@@ -209,7 +206,7 @@ impl GpuVolumes {
 
     pub fn destroy(self, ctx: &Context) {
         self.pipeline.destroy(ctx);
-        self.meshes.into_iter().for_each(|(_, m)| m.buffer.destroy(ctx));
+        self.meshes.destroy(ctx);
         self.params.into_iter().chain(self.commands).for_each(|b| b.destroy(ctx));
         self.vertices.into_iter().for_each(|v| v.destroy(ctx));
     }

@@ -16,7 +16,7 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::smoothie::{Penumbra, SmoothieSize};
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Variants, buffer_barrier,
+    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Uploads, Variants, buffer_barrier,
     dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId};
@@ -36,7 +36,8 @@ struct MeshBuffers {
 }
 
 impl MeshBuffers {
-    fn new(ctx: &Context, mesh: &Mesh) -> Result<Self> {
+    /// The mesh's buffers, their uploads recorded into `cmd`.
+    fn new(ctx: &Context, cmd: vk::CommandBuffer, mesh: &Mesh) -> Result<Self> {
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let positions: Vec<Vec4> = mesh.positions.iter().map(|p| p.extend(1.0)).collect();
         let triangles: Vec<[u32; 4]> = mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
@@ -50,7 +51,7 @@ impl MeshBuffers {
             ("silhouette edges", cast_slice(&edges)),
             ("silhouette stamps", cast_slice(&stamps)),
         ] {
-            match upload(ctx, name, bytes, storage) {
+            match upload(ctx, cmd, name, bytes, storage) {
                 Ok(b) => made.push(b),
                 Err(e) => {
                     made.into_iter().for_each(|b| b.destroy(ctx));
@@ -73,13 +74,14 @@ impl MeshBuffers {
 pub struct GpuSilhouettes {
     /// The silhouette pipeline, by whether the smoothie size is physical.
     pipelines: Variants<bool>,
-    meshes: Vec<(MeshId, MeshBuffers)>,
+    meshes: Uploads<MeshId, MeshBuffers>,
     params: Option<PerFrame>,
     vertices: Option<PerFrame>,
     args: PerFrame,
     stamp: u32,
-    /// What the output was last computed from; `None` when it must be computed.
-    computed: Option<OutputKey>,
+    /// What the output was last computed from, and the frames recorded before the frame that
+    /// computed it; `None` when it must be computed.
+    computed: Option<(OutputKey, u64)>,
 }
 
 /// Everything the silhouette output depends on.
@@ -99,7 +101,7 @@ impl GpuSilhouettes {
         let args = PerFrame::new(ctx, "smoothie draw", 16, FRAMES_IN_FLIGHT, usage)?;
         Ok(GpuSilhouettes {
             pipelines: Variants::default(),
-            meshes: Vec::new(),
+            meshes: Uploads::new(MeshBuffers::destroy),
             params: None,
             vertices: None,
             args,
@@ -119,11 +121,16 @@ impl GpuSilhouettes {
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
-        for o in &casters {
-            if !self.meshes.iter().any(|(id, _)| *id == o.mesh.id()) {
-                self.meshes.push((o.mesh.id(), MeshBuffers::new(ctx, &o.mesh)?));
-            }
+        // A frame that was never recorded ran neither its uploads nor its dispatches.
+        self.meshes.begin_frame(ctx);
+        if self.computed.as_ref().is_some_and(|(_, at)| *at == ctx.frames_recorded()) {
+            self.computed = None;
         }
+        let cmd = frame.cmd;
+        let meshes = casters
+            .iter()
+            .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
+            .collect::<Result<Vec<_>>>()?;
         // Six vertices per edge (twice, with the inner quads) and per corner.
         let quads_per_edge = 1 + centred as usize;
         let capacity: u64 = casters
@@ -161,7 +168,7 @@ impl GpuSilhouettes {
             centred,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
-        if self.computed.as_ref() == Some(&key) {
+        if self.computed.as_ref().is_some_and(|(k, _)| *k == key) {
             return Ok((vertices, args));
         }
         let pipeline = self.pipelines.get(physical, |&physical| {
@@ -200,8 +207,8 @@ impl GpuSilhouettes {
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
         update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0]));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
-        for (i, o) in casters.iter().enumerate() {
-            let mesh = &self.meshes.iter().find(|(id, _)| *id == o.mesh.id()).expect("uploaded above").1;
+        for (i, &at) in meshes.iter().enumerate() {
+            let mesh = self.meshes.get(at);
             let one = vk::DescriptorBufferInfo {
                 buffer: params_range.buffer,
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
@@ -224,13 +231,13 @@ impl GpuSilhouettes {
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
         frame.timer.end(ctx, cmd);
-        self.computed = Some(key);
+        self.computed = Some((key, ctx.frames_recorded()));
         Ok((vertices, args))
     }
 
     pub fn destroy(self, ctx: &Context) {
         self.pipelines.destroy(ctx);
-        self.meshes.into_iter().for_each(|(_, m)| m.destroy(ctx));
+        self.meshes.destroy(ctx);
         self.params.into_iter().chain(self.vertices).for_each(|b| b.destroy(ctx));
         self.args.destroy(ctx);
     }
