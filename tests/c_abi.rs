@@ -42,6 +42,21 @@ fn the_checked_in_header_is_generated_from_the_code() {
     }
 }
 
+/// The box's shadow in the `visibility.pgm` a C program wrote to `dir`, seen orthographically
+/// from above, 3 m each way (world x = (column + ½) / w · 6 − 3, z likewise): dark at x = 0.25,
+/// where the box's top edge falls, lit in the open and on the box's top. Returns the image's size.
+fn assert_box_shadow(dir: &Path) -> (usize, usize) {
+    let (w, h, v) = read_pgm(&dir.join("visibility.pgm"));
+    let at = |x: f32, z: f32| {
+        let (c, r) = (((x + 3.0) / 6.0 * w as f32) as usize, ((z + 3.0) / 6.0 * h as f32) as usize);
+        v[r * w + c] as f32 / 65535.0
+    };
+    assert!(at(0.25, 0.0) < 0.05, "V {} in the umbra", at(0.25, 0.0));
+    assert!(at(-2.0, 0.0) > 0.95 && at(2.5, 1.5) > 0.95, "V {} and {} in the open", at(-2.0, 0.0), at(2.5, 1.5));
+    assert!(at(1.0, 0.0) > 0.95, "V {} on the box's top", at(1.0, 0.0));
+    (w, h)
+}
+
 /// Reads a 16-bit binary PGM.
 fn read_pgm(path: &Path) -> (usize, usize, Vec<u16>) {
     let bytes = std::fs::read(path).unwrap();
@@ -74,15 +89,7 @@ fn the_c_game_loop_runs_and_shadows_where_physics_says() {
     assert_eq!(names, ["prepass", "shadow_map", "resolve", "composite"], "{stdout}");
     assert!(last.iter().all(|(_, ms)| *ms > 0.0), "{last:?}");
 
-    let (w, h, v) = read_pgm(&dir.join("visibility.pgm"));
-    // Orthographic from above, 3 m each way: world x = (column + ½) / w · 6 − 3, z likewise.
-    let at = |x: f32, z: f32| {
-        let (c, r) = (((x + 3.0) / 6.0 * w as f32) as usize, ((z + 3.0) / 6.0 * h as f32) as usize);
-        v[r * w + c] as f32 / 65535.0
-    };
-    assert!(at(0.25, 0.0) < 0.05, "V {} in the umbra", at(0.25, 0.0));
-    assert!(at(-2.0, 0.0) > 0.95 && at(2.5, 1.5) > 0.95, "V {} and {} in the open", at(-2.0, 0.0), at(2.5, 1.5));
-    assert!(at(1.0, 0.0) > 0.95, "V {} on the box's top", at(1.0, 0.0));
+    let (w, h) = assert_box_shadow(&dir);
     assert!(std::fs::metadata(dir.join("color.ppm")).unwrap().len() > (w * h * 3) as u64);
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_file(&exe).unwrap();
@@ -111,14 +118,7 @@ fn a_c_renderer_records_the_shadow_into_its_own_command_buffers() {
     let names: Vec<_> = passes.iter().map(|(n, _)| *n).collect();
     assert_eq!(names, ["import", "shadow_map", "resolve"], "{stdout}");
     assert!(passes.iter().all(|(_, ms)| *ms > 0.0), "{passes:?}");
-    let (w, h, v) = read_pgm(&dir.join("visibility.pgm"));
-    let at = |x: f32, z: f32| {
-        let (c, r) = (((x + 3.0) / 6.0 * w as f32) as usize, ((z + 3.0) / 6.0 * h as f32) as usize);
-        v[r * w + c] as f32 / 65535.0
-    };
-    assert!(at(0.25, 0.0) < 0.05, "V {} in the umbra", at(0.25, 0.0));
-    assert!(at(-2.0, 0.0) > 0.95 && at(2.5, 1.5) > 0.95, "V {} and {} in the open", at(-2.0, 0.0), at(2.5, 1.5));
-    assert!(at(1.0, 0.0) > 0.95, "V {} on the box's top", at(1.0, 0.0));
+    assert_box_shadow(&dir);
     std::fs::remove_dir_all(&dir).unwrap();
     std::fs::remove_file(&exe).unwrap();
 }
