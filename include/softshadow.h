@@ -38,8 +38,8 @@ typedef struct softshadow_scene softshadow_scene;
 // device (created with `softshadow_required_device_extension` and the Vulkan 1.3 features
 // dynamicRendering, synchronization2 and maintenance4), a queue of `queue_family`, and
 // optionally the embedder's `VkAllocationCallbacks` (NULL: none), copied at creation and passed
-// to every `vkCreate*` / `vkDestroy*` of the engine's objects: its functions and user data must
-// outlive the engine. Device memory blocks are allocated without them.
+// to every `vkCreate*` / `vkDestroy*` of the engine's objects and to the `vkAllocateMemory` /
+// `vkFreeMemory` of its device memory: its functions and user data must outlive the engine.
 typedef struct softshadow_vulkan {
   const void *get_instance_proc_addr;
   const void *instance;
