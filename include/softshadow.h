@@ -298,6 +298,15 @@ enum softshadow_status softshadow_record(struct softshadow_engine *engine,
                                          const struct softshadow_embedded_frame *frame,
                                          struct softshadow_recorded *recorded);
 
+// Forgets the frame `softshadow_record` recorded last, which the embedder will never submit
+// (it resets or frees the command buffer instead): the next `softshadow_record` uploads again
+// what that frame uploaded. Only right after that `softshadow_record`, before any other frame
+// (`SOFTSHADOW_ERROR_INVALID` otherwise).
+//
+// # Safety
+// `engine` is a live handle.
+enum softshadow_status softshadow_discard_recorded(struct softshadow_engine *engine);
+
 // Copies the pass times of the newest finished frame into `passes` (room for `capacity`) and
 // their number into `count`; `count` is 0 before any frame has finished.
 //

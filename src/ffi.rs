@@ -784,6 +784,22 @@ pub unsafe extern "C" fn softshadow_record(
     })
 }
 
+/// Forgets the frame `softshadow_record` recorded last, which the embedder will never submit
+/// (it resets or frees the command buffer instead): the next `softshadow_record` uploads again
+/// what that frame uploaded. Only right after that `softshadow_record`, before any other frame
+/// (`SOFTSHADOW_ERROR_INVALID` otherwise).
+///
+/// # Safety
+/// `engine` is a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn softshadow_discard_recorded(engine: *mut softshadow_engine) -> softshadow_status {
+    guard(|| {
+        let e = non_null_mut(engine, "engine")?;
+        e.engine.discard_recorded()?;
+        Ok(())
+    })
+}
+
 /// Copies the pass times of the newest finished frame into `passes` (room for `capacity`) and
 /// their number into `count`; `count` is 0 before any frame has finished.
 ///

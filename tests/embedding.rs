@@ -785,6 +785,46 @@ fn recording_over_an_unfinished_frame_is_an_error() {
     e.finish();
 }
 
+/// A frame the embedder records and then drops unsubmitted (its command buffer reset, the
+/// engine told by `discard_recorded`) never ran its uploads, so the next frame makes them again:
+/// for a smoothie with GPU silhouettes, the first frame ever (uploading the scene's meshes and
+/// the silhouette data) and then a frame showing new meshes, each discarded and recorded again,
+/// give the V of a fresh engine's own path to within 1 LSB, with no validation error. Only the
+/// frame recorded last can be discarded, once.
+#[test]
+fn a_discarded_frame_uploads_again_in_the_next() {
+    let e = embedder();
+    let mut engine = engine_on(&e);
+    let why = engine.discard_recorded().expect_err("nothing recorded").to_string();
+    assert!(why.contains("no frame to discard"), "{why}");
+    let mut p = params("smoothie");
+    p.set("gpu_silhouettes", "1").unwrap();
+    for box_x in [0.0, 0.5] {
+        // Parsed again: new meshes, which no frame has uploaded.
+        let s = scene(box_x);
+        let cam = engines_camera(&s);
+        let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, true);
+        frames.draw_depth(&e, &s, &cam);
+        let shot = Shot { scene: &s, params: &p, camera: cam, box_x };
+        e.begin(frames.cmd);
+        frames.record(&e, &mut engine, &shot, frames.cmd).unwrap();
+        unsafe { e.device.reset_command_buffer(frames.cmd, vk::CommandBufferResetFlags::empty()) }.unwrap();
+        engine.discard_recorded().unwrap();
+        assert!(engine.discard_recorded().is_err(), "a frame discarded twice");
+        let embedded = frames.run(&e, &mut engine, &shot).unwrap();
+        let mut fresh = engine_on(&e);
+        let mut settings = common::settings(&s, SIDE, SIDE);
+        settings.params = p.clone();
+        let own = fresh.render_and_capture(&s, &settings).unwrap().visibility;
+        drop(fresh);
+        let (over, max) = differences(&embedded, &own, 1);
+        assert!(over == 0, "box at {box_x}: {over} pixels differ by more than 1 LSB (max {max})");
+        frames.destroy(&e);
+    }
+    drop(engine);
+    e.finish();
+}
+
 /// A device created without what the engine needs is refused, the missing piece named.
 #[test]
 fn an_embedders_device_without_what_the_engine_needs_is_refused_by_name() {

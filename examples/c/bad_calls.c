@@ -203,6 +203,8 @@ int main(void) {
     frame.command_buffer = (void *)1;
     frame.depth.format = 37; /* VK_FORMAT_R8G8B8A8_UNORM is no depth format */
     EXPECT(softshadow_record(engine, scene, &frame, &recorded), SOFTSHADOW_ERROR_INVALID);
+    EXPECT(softshadow_discard_recorded(NULL), SOFTSHADOW_ERROR_NULL);
+    EXPECT_SAYING(softshadow_discard_recorded(engine), SOFTSHADOW_ERROR_INVALID, "no frame to discard"); /* none recorded */
 
     /* The message is truncated to the room given and terminated; its full length returned. */
     char tiny[4];

@@ -128,7 +128,16 @@ struct Retired {
     /// Frames recorded so far: submitted, or recorded into the embedder's command buffer.
     recorded: u64,
     items: Vec<(u64, Destroyer)>,
+    /// Whether the frame begun last has not been recorded yet.
+    open: bool,
+    /// Frames lost so far: begun but never recorded (an error), or discarded by the embedder.
+    lost: u64,
 }
+
+/// When data was uploaded by copies recorded into a frame ([`Context::upload_mark`]): the
+/// frames lost before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UploadMark(u64);
 
 /// Destroys one retired object.
 type Destroyer = Box<dyn FnOnce(&Context)>;
@@ -506,9 +515,41 @@ impl Context {
         self.retired.lock().expect("retire list").recorded
     }
 
+    /// A frame begins recording; the one begun before it, if never recorded, is lost.
+    pub(super) fn frame_begun(&self) {
+        let mut r = self.retired.lock().expect("retire list");
+        r.lost += u64::from(r.open);
+        r.open = true;
+    }
+
     /// A frame has been recorded (submitted, or handed to the embedder to submit).
     pub(super) fn frame_recorded(&self) {
-        self.retired.lock().expect("retire list").recorded += 1;
+        let mut r = self.retired.lock().expect("retire list");
+        r.recorded += 1;
+        r.open = false;
+    }
+
+    /// The frame recorded last was discarded by the embedder: it never runs, so it does not
+    /// count (what was retired meanwhile waits for frames that do), and it is lost.
+    pub(super) fn frame_discarded(&self) {
+        let mut r = self.retired.lock().expect("retire list");
+        r.recorded -= 1;
+        r.lost += 1;
+    }
+
+    /// The mark of data uploaded (or computed) by copies recorded into the frame being
+    /// recorded, for [`Context::upload_kept`].
+    pub fn upload_mark(&self) -> UploadMark {
+        UploadMark(self.retired.lock().expect("retire list").lost)
+    }
+
+    /// Whether data marked `mark` is (or will be, once the frames recorded so far run) on the
+    /// GPU: no frame has been lost since it was uploaded, so the frame that uploaded it is the
+    /// one being recorded or was recorded (frames are lost only between frames). After a lost
+    /// frame every earlier upload counts as lost too: uploading again is cheaper than
+    /// remembering which frame was lost.
+    pub fn upload_kept(&self, mark: UploadMark) -> bool {
+        mark.0 == self.retired.lock().expect("retire list").lost
     }
 
     /// Destroys what was retired before the frames now known finished: called as frame n

@@ -19,7 +19,7 @@ mod timestamps;
 mod upload;
 
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
-pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership};
+pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership, UploadMark};
 pub use device::{
     CreateSurface, DeviceFilter, required_core_features, required_device_extensions, required_vulkan13_features,
 };

@@ -16,8 +16,8 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::smoothie::{Penumbra, SmoothieSize};
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Uploads, Variants, buffer_barrier,
-    dispatch, shaders, update_buffer, upload,
+    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
+    buffer_barrier, dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId};
 
@@ -79,9 +79,9 @@ pub struct GpuSilhouettes {
     vertices: Option<PerFrame>,
     args: PerFrame,
     stamp: u32,
-    /// What the output was last computed from, and the frames recorded before the frame that
-    /// computed it; `None` when it must be computed.
-    computed: Option<(OutputKey, u64)>,
+    /// What the output was last computed from, and when ([`Context::upload_kept`] says whether
+    /// that frame ran); `None` when it must be computed.
+    computed: Option<(OutputKey, UploadMark)>,
 }
 
 /// Everything the silhouette output depends on.
@@ -121,11 +121,6 @@ impl GpuSilhouettes {
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
-        // A frame that was never recorded ran neither its uploads nor its dispatches.
-        self.meshes.begin_frame(ctx);
-        if self.computed.as_ref().is_some_and(|(_, at)| *at == ctx.frames_recorded()) {
-            self.computed = None;
-        }
         let cmd = frame.cmd;
         let meshes = casters
             .iter()
@@ -168,7 +163,8 @@ impl GpuSilhouettes {
             centred,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
-        if self.computed.as_ref().is_some_and(|(k, _)| *k == key) {
+        // A lost frame ran neither its uploads nor its dispatches.
+        if self.computed.as_ref().is_some_and(|(k, at)| *k == key && ctx.upload_kept(*at)) {
             return Ok((vertices, args));
         }
         let pipeline = self.pipelines.get(physical, |&physical| {
@@ -231,7 +227,7 @@ impl GpuSilhouettes {
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
         frame.timer.end(ctx, cmd);
-        self.computed = Some((key, ctx.frames_recorded()));
+        self.computed = Some((key, ctx.upload_mark()));
         Ok((vertices, args))
     }
 
