@@ -145,3 +145,48 @@ pub fn copy_to_buffer(
 ) {
     unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, target.image, target.last.layout, dst.buffer, regions) };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::{ContextOptions, FrameRing, Semaphores};
+
+    /// Data a frame uploads is kept while frames are submitted (and within its own frame), and
+    /// made again once a frame is lost: begun and never submitted, as on an error, or recorded
+    /// into an embedder's command buffer and discarded.
+    #[test]
+    fn what_a_lost_frame_uploaded_is_made_again() {
+        let mut ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
+        let mut ring = FrameRing::new(&ctx).unwrap();
+        let mut uploads: Uploads<u32, Buffer> = Uploads::new(Buffer::destroy);
+        let mut made = 0;
+        // A frame uploading `keys` into the ring's command buffer, submitted or lost.
+        let mut frame = |ctx: &Context, ring: &mut FrameRing, keys: &[u32], submit: bool| {
+            let (slot, cmd) = ring.begin(ctx).map(|(f, _)| (f.slot, f.cmd)).unwrap();
+            for &key in keys {
+                let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+                uploads
+                    .index(ctx, key, || {
+                        made += 1;
+                        upload(ctx, cmd, "uploaded", &[1, 2, 3, 4], usage)
+                    })
+                    .unwrap();
+            }
+            if submit {
+                ring.submit(ctx, slot, &Semaphores::NONE).unwrap();
+            }
+            made
+        };
+        assert_eq!(frame(&ctx, &mut ring, &[1, 1], true), 1, "made twice in its own frame");
+        assert_eq!(frame(&ctx, &mut ring, &[1], true), 1, "made again after a submitted frame");
+        assert_eq!(frame(&ctx, &mut ring, &[2], false), 2);
+        // Frame 3 was lost: its upload is made again, and, no earlier upload being trusted, 1's.
+        assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "not made again after a lost frame");
+        assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "made again after frames were submitted");
+        ring.drain(&ctx).unwrap();
+        uploads.destroy(&ctx);
+        ring.destroy(&ctx);
+        ctx.destroy();
+        assert!(ctx.validation_errors().is_empty(), "{:?}", ctx.validation_errors());
+    }
+}
