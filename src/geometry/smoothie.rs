@@ -164,8 +164,8 @@ pub fn silhouette(caster: &Caster<'_>, light: Vec3) -> Vec<([u32; 2], u32)> {
     penumbra_edges(caster, &light_facing(caster, light), EdgeSource::Silhouettes)
 }
 
-/// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (world →
-/// light view, +z away from the light), for receivers no farther than `far`. Each silhouette
+/// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (the caster's
+/// positions → light view, +z away from the light), for receivers no farther than `far`. Each silhouette
 /// vertex gets one corner (`mailbox`); with [`Penumbra::Centred`] each edge an inner quad too.
 pub fn smoothies(
     view: &Mat4,

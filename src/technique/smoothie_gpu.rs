@@ -183,7 +183,7 @@ impl GpuSilhouettes {
         for o in &casters {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             let model = o.transform.matrix();
-            let (near, caster_far) = match penumbra(centred, view, &o.mesh.bounds.transformed(&model)) {
+            let (near, caster_far) = match penumbra(centred, &(*view * model), &o.mesh.bounds) {
                 Penumbra::Centred { near, far } => (near, far),
                 Penumbra::Outer => (0.0, 0.0),
             };
