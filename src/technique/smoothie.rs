@@ -48,7 +48,7 @@ use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::Aabb;
-use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox, penumbra_edges};
+use crate::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
 use crate::geometry::smoothie::{Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, Fullscreen, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
@@ -177,8 +177,6 @@ pub struct Smoothie {
     buffer: Option<Target>,
     falloff: Falloff,
     silhouettes: Vec<Option<CasterSilhouette>>,
-    mailbox: Mailbox,
-    frame: u64,
     /// The compute path, made when first asked for.
     gpu: Option<GpuSilhouettes>,
 }
@@ -196,8 +194,6 @@ impl Smoothie {
             buffer: None,
             falloff: Falloff::default(),
             silhouettes: Vec::new(),
-            mailbox: Mailbox::default(),
-            frame: 0,
             gpu: None,
         })
     }
@@ -237,9 +233,7 @@ impl Smoothie {
             let c = cached.as_ref().expect("set above");
             let view = *view * model;
             let penumbra = penumbra(centred, &view, &o.mesh.bounds);
-            // Vertex numbers are per mesh: a fresh stamp per caster keeps the mailboxes apart.
-            self.frame += 1;
-            out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra, &mut self.mailbox, self.frame));
+            out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra));
         }
         out
     }
