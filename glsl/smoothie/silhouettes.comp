@@ -141,17 +141,25 @@ void corner(Silhouette s, int k, uint count, uint other) {
     if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
         vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
         vec2 d2 = (other & 1u) == 0u ? o.along : -o.along, n2 = o.normal;
-        bool convex = dot(n1, d2) < 0.0, also = dot(n2, d1) < 0.0;
-        if (!convex && !also) {
+        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square.
+        vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
+        bool consistent = dot(p1, n1) * dot(p2, n2) > 0.0;
+        bool concave = dot(n1, d2) >= 0.0;
+        if (consistent && concave && params.counts.w == 0u) {
             return; // concave or straight: the two edges' quads overlap
         }
         vec2 m = n1 + n2;
-        if (convex && also && dot(m, m) > 0.0) {
+        if (consistent && !concave && dot(m, m) > 0.0) {
             m = normalize(m);
             vec2 ns[2] = vec2[2](n1, n2);
             for (int j = 0; j < 2; j++) {
                 vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
                 corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk));
+            }
+            if (params.counts.w != 0u) {
+                // Centred: the square's inner half too, as src/geometry/smoothie.rs.
+                vec2 across = vec2(-m.y, m.x) * kk;
+                corner_quad(p, z, t, vec2[4](across, across - m * kk, -across - m * kk, -across));
             }
             return;
         }

@@ -134,11 +134,12 @@ impl GpuSilhouettes {
             .iter()
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
-        // Six vertices per quad: one per edge (two with the inner quads), at most two per corner.
+        // Six vertices per quad: one per edge (two with the inner quads), at most three per
+        // corner.
         let quads_per_edge = 1 + centred as usize;
         let capacity: u64 = casters
             .iter()
-            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + 2 * o.mesh.positions.len()) as u64)
+            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + 3 * o.mesh.positions.len()) as u64)
             .sum();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         PerFrame::ensure(
