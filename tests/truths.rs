@@ -225,6 +225,41 @@ fn a_huge_light_just_above_the_ground() {
     finish(e);
 }
 
+/// A slab 0.5 m up that casts nothing, under a box 2 m up, seen from above; a light
+/// `distance` away towards (1, 1, 0.3), 0.02 rad in radius whatever its distance.
+fn raised_receiver(distance: f32) -> Scene {
+    let objects = "[[object]]\nshape = \"box\"\nsize = [2.0, 0.2, 2.0]\nposition = [0.0, 2.0, 0.0]\nreceives = false\n\
+                   [[object]]\nshape = \"box\"\nsize = [5.6, 0.2, 5.6]\nposition = [0.0, 0.4, 0.0]\ncasts = false\n";
+    let light = Vec3::new(1.0, 1.0, 0.3).normalize() * distance;
+    common::top_down(0.0, 3.0, light.to_array(), 0.02 * distance, objects)
+}
+
+/// Issue 19: plateau's projected light map (`off_plane = 1`) under far lights. A surface was
+/// on the ground within 1e-3 of the light's height: under a light taken nearer (256 scene
+/// widths) that is a quarter of the scene, and the slab read the ground's shadow where it
+/// stands (RMSE 0.17 from 1e4 m and from 1e8 m). Off the plane, the projection along the light's
+/// rays `light + (p − light) · hl / (hl − h)` rounded p to the ulp of the light's position (8 m
+/// from 1e8 m: RMSE 0.18 from 1e7 m, 0.33 from 1e8 m). The slab must come out as well from 1e8 m
+/// as from 1e4 m, where f32 is exact enough for either form.
+#[test]
+fn plateau_projects_raised_receivers_from_far_lights() {
+    let mut e = engine();
+    let error = |e: &mut Engine, distance: f32| {
+        let s = raised_receiver(distance);
+        let truth = render_with(e, &s, "raytrace", &[("samples", "256")], 64);
+        let c = render_with(e, &s, "plateau", &[("off_plane", "1")], 64);
+        assert!(shadowed(&truth) > 0.05, "the box shadows the slab from {distance:e} m");
+        Metrics::between(&c, &truth).unwrap().rmse
+    };
+    let near = error(&mut e, 1e4);
+    assert!(near < 0.1, "plateau's light map on the slab from 1e4 m: RMSE {near}");
+    for distance in [1e6, 1e7, 1e8] {
+        let far = error(&mut e, distance);
+        assert!(far < near + 0.02, "from {distance:e} m: RMSE {far}, from 1e4 m {near}");
+    }
+    finish(e);
+}
+
 /// Log-uniform in [10^lo, 10^hi].
 fn log_uniform(lo: f32, hi: f32) -> impl Strategy<Value = f32> {
     (lo..hi).prop_map(|x| 10f32.powf(x))
@@ -305,7 +340,7 @@ fn check(e: &mut Engine, case: &Case) -> Result<(), TestCaseError> {
 }
 
 /// Cases the property found, each once failing (the figures before the fix), checked every run.
-const FOUND: [(Case, &str); 7] = [
+const FOUND: [(Case, &str); 9] = [
     // A 1.2 mm cube, a point light 73 m off: the f32 light depths rounded by 2e-6 m, over the
     // texel biases (6e-7 m), and shadow-map shadowed half the cube's lit top (V 1.0 off on 24 %).
     (
@@ -334,6 +369,23 @@ const FOUND: [(Case, &str); 7] = [
     (
         Case { s: 0.01687815, radius: 0.0, gap: 1967051.0, elevation_deg: 20.0, spread: 53066.113 },
         "huge ground, small cube",
+    ),
+    // A 1.8 mm cube, a point light 4.4 km off, a ground of half size 1.5e5 m: the receivers in
+    // view, the ground clipped by the camera frustum with a slack of 1e-5 of either solid
+    // (metres: the frustum is 1.5e5 m deep), came out metres wide and high for a patch
+    // centimetres wide, the projection centre stayed kilometres off, and PCSS's receiver-plane
+    // margin (the depth rounding there, 2 mm) hid the cube's whole shadow (RMSE 0.26; at 45°
+    // every shadow-map technique and `reference` lost it too, 0.19).
+    (
+        Case { s: 0.0018, radius: 0.0, gap: 4400.0, elevation_deg: 20.0, spread: 74990.0 },
+        "PCSS, tiny cube, wide ground",
+    ),
+    // The same cause under a 1.1 mm cube and a light 5.8e6 m away: the depth rounding at the
+    // projection centre leaked the cube's shadow in every technique on the shadow map,
+    // `reference` included (RMSE 0.17, 0.086 off hard edges).
+    (
+        Case { s: 0.0011405764, radius: 0.0, gap: 5752678.0, elevation_deg: 67.47841, spread: 44225.746 },
+        "shadow maps, tiny cube, wide ground",
     ),
     // A point light 5.8e7 m away: projective-texture's f32 image of the cube from there lost
     // the whole shadow (RMSE 0.30).
