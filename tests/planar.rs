@@ -96,3 +96,28 @@ fn no_anti_shadow_for_a_caster_above_the_light() {
     assert!(planar.visibility_at(0, 32) == 0.0 && planar.visibility_at(63, 32) == 1.0);
     finish(e);
 }
+
+/// A slab whose top is 0.5 m above the ground under a point light 1 km up and over, a box above it: the
+/// slab's top is not the plane however high the light (a tolerance of a thousandth of the
+/// light's height took it for the ground, issue 19), so the box's shadow lands on the ground
+/// around the slab only and the slab keeps V = 1.
+#[test]
+fn a_raised_slab_is_not_the_plane_under_a_high_light() {
+    let objects = "[[object]]\nshape = \"box\"\nsize = [3.0, 0.5, 3.0]\nposition = [0.0, 0.25, 0.0]\n\
+        [[object]]\nshape = \"box\"\nsize = [4.0, 0.2, 1.0]\nposition = [0.0, 2.0, 0.0]\n";
+    let s = top_down(0.0, 3.0, [0.0, 1000.0, 1000.0], 0.0, objects);
+    let mut e = engine();
+    let ray = render_with(&mut e, &s, "raytrace", &[], 64);
+    let planar = render_with(&mut e, &s, "planar", &[], 64);
+    let (_, wrong, elsewhere) = compare(&planar, &ray);
+    let slab_in_shadow = (0..ray.visibility.len()).filter(|&i| !ground(&ray, i) && ray.visibility[i] < 32768).count();
+    assert!(slab_in_shadow > 100, "the box shadows the slab in truth: {slab_in_shadow} px");
+    assert!(wrong.is_empty(), "{} ground px differ, first {:?}", wrong.len(), &wrong[..wrong.len().min(6)]);
+    assert!(
+        elsewhere.is_empty(),
+        "{} px off the plane not 1, first {:?}",
+        elsewhere.len(),
+        &elsewhere[..elsewhere.len().min(6)]
+    );
+    finish(e);
+}

@@ -84,9 +84,8 @@ struct SampleView {
     mat4 transform;  // world -> clip: the camera's (volumes), or the camera's * Blinn's (planar)
     vec4 light;      // xyz: the light point; w: volumes' reach (0: to infinity, w = 0)
     vec4 plane;      // planar: the receiver plane, n.xyz and w = -n.o
-    vec4 tolerance;  // planar: x = how far off the plane a surface may be and still be on it
     vec4 normal;     // xyz the light sphere's normal at the point (0: a point light), w its weight
-    vec4 pad[8];
+    vec4 pad[9];
 };
 
 // The classic systems' frame (blob, concentric, projective texture).

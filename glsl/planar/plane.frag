@@ -14,8 +14,8 @@ layout(location = 0) in vec2 in_uv;
 
 void main() {
     Surface s = read_surface(frame, camera_depth, camera_normal, in_uv);
-    float h = dot(s.p, view.plane.xyz) + view.plane.w;
-    if (!s.receives || abs(h) > view.tolerance.x) {
+    vec3 n = view.plane.xyz;
+    if (!s.receives || !on_plane(frame, s, -view.plane.w * n, n)) {
         discard;
     }
 }

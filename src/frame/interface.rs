@@ -103,10 +103,9 @@ pub struct SampleView {
     pub transform: Mat4,
     pub light: Vec4,
     pub plane: Vec4,
-    pub tolerance: Vec4,
     /// The light sphere's normal at the point and its importance weight (`LightSample::normal`).
     pub normal: Vec4,
-    pub pad: [Vec4; 8],
+    pub pad: [Vec4; 9],
 }
 
 /// The classic systems' frame (blob, concentric, projective texture): the receiver plane, the

@@ -102,10 +102,8 @@ impl Technique for Planar {
                 transform: frame.camera.view_proj * plane.blinn_matrix(q),
                 light: q.extend(1.0),
                 plane: equation,
-                // As the plateau's resolve: a thousandth of the light's height.
-                tolerance: Vec4::new(1e-3 * plane.height(q).abs(), 0.0, 0.0, 0.0),
                 normal,
-                pad: [Vec4::ZERO; 8],
+                pad: [Vec4::ZERO; 9],
             })
             .collect();
         let extent = visibility.extent();

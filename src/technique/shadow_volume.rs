@@ -355,9 +355,8 @@ impl Technique for ShadowVolumes {
                 transform: frame.camera.view_proj,
                 light: q.extend(reach),
                 plane: Vec4::ZERO,
-                tolerance: Vec4::ZERO,
                 normal,
-                pad: [Vec4::ZERO; 8],
+                pad: [Vec4::ZERO; 9],
             })
             .collect();
         let extent = visibility.extent();
