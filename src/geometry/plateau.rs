@@ -18,6 +18,8 @@ use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
 
 use std::f32::consts::TAU;
 
+use rayon::prelude::*;
+
 use super::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 
 /// Fraction of the light's height above which a point casts nothing: its projection from the
@@ -378,79 +380,59 @@ pub fn plateau_sides(
     if source == EdgeSource::Silhouettes && !caster.adjacency.is_closed() {
         edges.extend(unlit_boundary_edges(caster, &facing));
     }
-    let mut out = PlateauGeometry::default();
     // Each edge end (2i, 2i + 1 for edge i) to its vertex's cone, computed once per vertex.
     let mut ends: Vec<(u32, u32)> =
         edges.iter().enumerate().flat_map(|(i, ([a, b], _))| [(*a, 2 * i as u32), (*b, 2 * i as u32 + 1)]).collect();
     ends.sort_unstable();
-    let mut cones: Vec<Option<Cone>> = Vec::new();
+    let groups: Vec<&[(u32, u32)]> = ends.chunk_by(|x, y| x.0 == y.0).collect();
+    let cones: Vec<Option<Cone>> = groups
+        .par_iter()
+        .map(|g| vertex_cone(plane, light.position, light.radius, light.size, caster.positions[g[0].0 as usize]))
+        .collect();
     let mut cone_of_end = vec![0u32; ends.len()];
-    for (k, &(v, end)) in ends.iter().enumerate() {
-        if k == 0 || ends[k - 1].0 != v {
-            let cone = vertex_cone(plane, light.position, light.radius, light.size, caster.positions[v as usize]);
-            if let Some(c) = &cone {
-                out.grow(c.centre);
+    for (k, g) in groups.iter().enumerate() {
+        g.iter().for_each(|(_, end)| cone_of_end[*end as usize] = k as u32);
+    }
+    let cone_of_end = &cone_of_end;
+    let cone = |end: usize| cones[cone_of_end[end] as usize];
+    // Chunks of edges, then of vertices, in parallel (rayon), put together in order.
+    let parts: Vec<(PlateauGeometry, Vec<Covers>)> = edges
+        .par_chunks(PARALLEL_CHUNK)
+        .enumerate()
+        .map(|(c, chunk)| {
+            let mut out = PlateauGeometry::default();
+            let mut covers = Vec::with_capacity(2 * chunk.len());
+            for (j, &(_, inner)) in chunk.iter().enumerate() {
+                let i = c * PARALLEL_CHUNK + j;
+                let ends = (cone(2 * i), cone(2 * i + 1));
+                let inside = plane.project(light.position, caster.positions[inner as usize]);
+                covers.extend(edge_sheets(&mut out, light.penumbra, ends, inside, number));
             }
-            cones.push(cone);
-        }
-        cone_of_end[end as usize] = cones.len() as u32 - 1;
+            (out, covers)
+        })
+        .collect();
+    let mut out = PlateauGeometry::default();
+    let mut covers = Vec::with_capacity(ends.len());
+    for (g, c) in parts {
+        out.extend(&g);
+        covers.extend(c);
     }
-    // What the sheets cover at each edge end: from the end, the directions of the hard edge and
-    // of the tangent point, or outer only, of the inner normal.
-    let mut covers: Vec<[Option<(Vec2, Vec2)>; 2]> = vec![[None; 2]; ends.len()];
-    for (i, &([_, _], inner)) in edges.iter().enumerate() {
-        let (ea, eb) = (2 * i, 2 * i + 1);
-        let (Some(ca), Some(cb)) = (cones[cone_of_end[ea] as usize], cones[cone_of_end[eb] as usize]) else {
-            continue;
-        };
-        let Some(inside) = plane.project(light.position, caster.positions[inner as usize]) else { continue };
-        // Outward: away from the light-facing triangle's third vertex, across the edge.
-        let mid = 0.5 * (ca.centre + cb.centre);
-        let along = (cb.centre - ca.centre).normalize_or_zero();
-        let across = (mid - inside) - along * (mid - inside).dot(along);
-        // An edge seen edge-on from its own triangle: either side (the GPU probes both).
-        let normal = across.try_normalize().unwrap_or(along.perp());
-        let ab = cb.centre - ca.centre;
-        for (k, side) in [normal, -normal].into_iter().enumerate() {
-            let cover = if k == 0 || light.penumbra == Penumbra::Centred {
-                let Some((ta, tb)) = outer_tangent(&ca, &cb, side) else { continue };
-                if !out.push_sheet(ca.centre, cb.centre, ta, tb, normal, number) {
-                    continue;
-                }
-                (ta - ca.centre, tb - cb.centre)
-            } else {
-                (side, side)
-            };
-            covers[ea][k] = Some((ab, cover.0));
-            covers[eb][k] = Some((-ab, cover.1));
-        }
-    }
-    let (mut arcs, mut gaps) = (Vec::new(), Vec::new());
-    for group in ends.chunk_by(|x, y| x.0 == y.0) {
-        let Some(cone) = cones[cone_of_end[group[0].1 as usize] as usize] else { continue };
-        if cone.is_point() {
-            continue;
-        }
-        arcs.clear();
-        gaps.clear();
-        // Whole cones, or a flat base (no width across, no rim angles): the whole cone.
-        let inverse = (light.wedges && cone.axes.determinant() > 0.0).then(|| cone.axes.inverse());
-        for (from, to) in group.iter().flat_map(|(_, end)| covers[*end as usize]).flatten() {
-            let Some(inverse) = inverse else { break };
-            // Anticlockwise from one side of the sector to the other; a flat sector covers nothing.
-            let (from, to) = if from.perp_dot(to) >= 0.0 { (from, to) } else { (to, from) };
-            if from.perp_dot(to) <= 1e-6 * from.length() * to.length() {
-                continue;
+    let covers = &covers;
+    let wedges: Vec<PlateauGeometry> = groups
+        .par_chunks(PARALLEL_CHUNK)
+        .map(|chunk| {
+            let mut out = PlateauGeometry::default();
+            let (mut arcs, mut gaps) = (Vec::new(), Vec::new());
+            for group in chunk {
+                let Some(cone) = cone(group[0].1 as usize) else { continue };
+                out.grow(cone.centre);
+                let covered = group.iter().flat_map(|(_, end)| covers[*end as usize]).flatten();
+                vertex_wedges(&mut out, &cone, light, covered, (&mut arcs, &mut gaps), number);
             }
-            let start = cone.rim_angle(inverse, from);
-            arcs.push((start.rem_euclid(TAU), (cone.rim_angle(inverse, to) - start).rem_euclid(TAU)));
-        }
-        let overlap = if arcs.is_empty() { 0.0 } else { WEDGE_OVERLAP };
-        uncovered(&mut arcs, &mut gaps);
-        for &(from, to) in &gaps {
-            out.push_wedge(&cone, (from - overlap, to + overlap), light.cone_segments, number);
-        }
-    }
+            out
+        })
+        .collect();
+    wedges.iter().for_each(|g| out.extend(g));
     let hl = plane.height(light.position);
     out.unbounded = caster.positions.iter().any(|p| plane.height(*p) >= hl * (1.0 - ABOVE_LIGHT));
     if source == EdgeSource::LightFacing {
@@ -462,13 +444,92 @@ pub fn plateau_sides(
     out
 }
 
+/// Edges, or vertices, per parallel task: enough work to outweigh the task.
+const PARALLEL_CHUNK: usize = 256;
+
+/// What the sheets of an edge cover at its two ends, outer side then inner: from the end, the
+/// directions of the hard edge and of the tangent point (outer only, of the inner normal: the
+/// hard shadow there is t = 0 whatever the sides hold).
+type Covers = [Option<(Vec2, Vec2)>; 2];
+
+/// The sheets of an edge between the cones of its ends, `inside` the projected third vertex of
+/// its light-facing triangle, into `out`; what they cover at each end.
+fn edge_sheets(
+    out: &mut PlateauGeometry,
+    penumbra: Penumbra,
+    ends: (Option<Cone>, Option<Cone>),
+    inside: Option<Vec2>,
+    number: f32,
+) -> [Covers; 2] {
+    let mut covers = [[None; 2]; 2];
+    let ((Some(ca), Some(cb)), Some(inside)) = (ends, inside) else { return covers };
+    // Outward: away from the light-facing triangle's third vertex, across the edge.
+    let mid = 0.5 * (ca.centre + cb.centre);
+    let along = (cb.centre - ca.centre).normalize_or_zero();
+    let across = (mid - inside) - along * (mid - inside).dot(along);
+    // An edge seen edge-on from its own triangle: either side (the GPU probes both).
+    let normal = across.try_normalize().unwrap_or(along.perp());
+    let ab = cb.centre - ca.centre;
+    for (k, side) in [normal, -normal].into_iter().enumerate() {
+        let cover = if k == 0 || penumbra == Penumbra::Centred {
+            let Some((ta, tb)) = outer_tangent(&ca, &cb, side) else { continue };
+            if !out.push_sheet(ca.centre, cb.centre, ta, tb, normal, number) {
+                continue;
+            }
+            (ta - ca.centre, tb - cb.centre)
+        } else {
+            (side, side)
+        };
+        covers[0][k] = Some((ab, cover.0));
+        covers[1][k] = Some((-ab, cover.1));
+    }
+    covers
+}
+
+/// The parts of a vertex's cone that none of the sheets there cover (`covered`: sectors from
+/// the apex, see [`Covers`]), into `out`; `scratch`: reused arc lists.
+fn vertex_wedges(
+    out: &mut PlateauGeometry,
+    cone: &Cone,
+    light: &PlateauLight,
+    covered: impl Iterator<Item = (Vec2, Vec2)>,
+    (arcs, gaps): (&mut Arcs, &mut Arcs),
+    number: f32,
+) {
+    if cone.is_point() {
+        return;
+    }
+    arcs.clear();
+    gaps.clear();
+    // Whole cones, or a flat base (no width across, no rim angles): the whole cone.
+    if let Some(inverse) = (light.wedges && cone.axes.determinant() > 0.0).then(|| cone.axes.inverse()) {
+        for (from, to) in covered {
+            // Anticlockwise from one side of the sector to the other; a flat sector covers nothing.
+            let (from, to) = if from.perp_dot(to) >= 0.0 { (from, to) } else { (to, from) };
+            if from.perp_dot(to) <= 1e-6 * from.length() * to.length() {
+                continue;
+            }
+            let start = cone.rim_angle(inverse, from);
+            arcs.push((start.rem_euclid(TAU), (cone.rim_angle(inverse, to) - start).rem_euclid(TAU)));
+        }
+    }
+    let overlap = if arcs.is_empty() { 0.0 } else { WEDGE_OVERLAP };
+    uncovered(arcs, gaps);
+    for &(from, to) in gaps.iter() {
+        out.push_wedge(cone, (from - overlap, to + overlap), light.cone_segments, number);
+    }
+}
+
+/// Arcs of rim angles, (start, length) or (from, to).
+type Arcs = Vec<(f32, f32)>;
+
 /// Radians by which a corner wedge overlaps the sheets beside it: no crack between them
 /// (their shared side is the same line, computed two ways).
 const WEDGE_OVERLAP: f32 = 1e-3;
 
 /// The arcs of the circle of angles that none of `arcs` (start in [0, 2π), length) covers,
 /// as (from, to) with from < to, into `gaps`; all of it when `arcs` is empty.
-fn uncovered(arcs: &mut [(f32, f32)], gaps: &mut Vec<(f32, f32)>) {
+fn uncovered(arcs: &mut [(f32, f32)], gaps: &mut Arcs) {
     arcs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let Some(&(first, length)) = arcs.first() else {
         gaps.push((0.0, TAU));
