@@ -7,7 +7,7 @@ use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use softshadow::geometry::silhouette::{Caster, Mailbox};
+use softshadow::geometry::silhouette::Caster;
 use softshadow::geometry::smoothie::{Penumbra, SmoothieSize, silhouette, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
@@ -27,13 +27,8 @@ fn smoothie(c: &mut Criterion) {
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
     let view = frustum.view;
     let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
-    let mut mailbox = Mailbox::default();
-    let mut frame = 0;
     group.bench_function("smoothie geometry", |b| {
-        b.iter(|| {
-            frame += 1;
-            smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer, &mut mailbox, frame)
-        })
+        b.iter(|| smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer))
     });
     group.finish();
 }

@@ -106,8 +106,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let started = Instant::now();
         let (near, far) = depth_range(&frustum.view, &bounds);
         let penumbra = smoothie::Penumbra::Centred { near, far };
-        let g =
-            smoothies(&frustum.view, &caster, &closed_edges, (size, frustum.far), penumbra, &mut Mailbox::default(), 1);
+        let g = smoothies(&frustum.view, &caster, &closed_edges, (size, frustum.far), penumbra);
         let smoothie_ms = started.elapsed().as_secs_f64() * 1e3;
         let [x0, y0, x1, y1] = frustum.window;
         let smoothie_texel = (texels * texels) / f64::from((x1 - x0) * (y1 - y0));

@@ -27,6 +27,14 @@ typedef enum softshadow_status {
   SOFTSHADOW_ERROR_PANIC = 8,
 } softshadow_status;
 
+// The window systems a `softshadow_native_window` can name.
+typedef enum softshadow_window_kind {
+  SOFTSHADOW_WINDOW_XLIB = 1,
+  SOFTSHADOW_WINDOW_XCB = 2,
+  SOFTSHADOW_WINDOW_WAYLAND = 3,
+  SOFTSHADOW_WINDOW_WIN32 = 4,
+} softshadow_window_kind;
+
 // An engine and what it renders at: size, technique and knobs, and the last finished frame's
 // pass times.
 typedef struct softshadow_engine softshadow_engine;
@@ -34,12 +42,25 @@ typedef struct softshadow_engine softshadow_engine;
 // A scene: casters, receivers, one light, one camera.
 typedef struct softshadow_scene softshadow_scene;
 
+// A window the embedder owns, by its native handles. `kind` is a `softshadow_window_kind`;
+// the other fields, by kind (a field the kind does not use must be 0 / NULL):
+// - XLIB: `display` the `Display *`, `window` the `Window`;
+// - XCB: `display` the `xcb_connection_t *`, `window` the `xcb_window_t`;
+// - WAYLAND: `display` the `struct wl_display *`, `surface` the `struct wl_surface *`;
+// - WIN32: `surface` the `HWND`, `display` its `HINSTANCE` (may be NULL).
+typedef struct softshadow_native_window {
+  uint32_t kind;
+  void *display;
+  uint64_t window;
+  void *surface;
+} softshadow_native_window;
+
 // The embedder's Vulkan objects: `vkGetInstanceProcAddr`, the instance, physical device and
 // device (created with `softshadow_required_device_extension` and the Vulkan 1.3 features
 // dynamicRendering, synchronization2 and maintenance4), a queue of `queue_family`, and
 // optionally the embedder's `VkAllocationCallbacks` (NULL: none), copied at creation and passed
-// to every `vkCreate*` / `vkDestroy*` of the engine's objects: its functions and user data must
-// outlive the engine. Device memory blocks are allocated without them.
+// to every `vkCreate*` / `vkDestroy*` of the engine's objects and to the `vkAllocateMemory` /
+// `vkFreeMemory` of its device memory: its functions and user data must outlive the engine.
 typedef struct softshadow_vulkan {
   const void *get_instance_proc_addr;
   const void *instance;
@@ -171,16 +192,18 @@ const char *softshadow_required_device_extension(size_t index);
 enum softshadow_status softshadow_engine_create_headless(uint32_t validation,
                                                          struct softshadow_engine **out_engine);
 
-// Creates an engine on a device of its own that presents to the embedder's Xlib `window` on
-// `display` (`Display*` and `Window`), FIFO, at the window's size; `validation` as for
-// `softshadow_engine_create_headless`. Present frames with `softshadow_present`.
+// Creates an engine on a device of its own that presents to the embedder's native window
+// (Xlib, xcb, Wayland or Win32), FIFO, at the window's size; `validation` as for
+// `softshadow_engine_create_headless`. Present frames with `softshadow_present`. A window
+// system whose surface extension the Vulkan loader lacks is refused
+// (`SOFTSHADOW_ERROR_DEVICE`, the extension named).
 //
 // # Safety
-// `display` is an open display and `window` a window on it; both outlive the engine.
-enum softshadow_status softshadow_engine_create_xlib(void *display,
-                                                     unsigned long window,
-                                                     uint32_t validation,
-                                                     struct softshadow_engine **out_engine);
+// `window` is NULL or points at a description whose handles are valid (an open display or
+// connection, a live window or surface on it); they outlive the engine.
+enum softshadow_status softshadow_engine_create_window(const struct softshadow_native_window *window,
+                                                       uint32_t validation,
+                                                       struct softshadow_engine **out_engine);
 
 // Creates an engine on the embedder's Vulkan objects; it never destroys them. A device
 // without a required extension or feature is refused (`SOFTSHADOW_ERROR_INVALID`, the
@@ -232,7 +255,7 @@ enum softshadow_status softshadow_render(struct softshadow_engine *engine,
                                          const struct softshadow_scene *scene);
 
 // Renders one frame of `scene` at the window's size and presents it (an engine made by
-// `softshadow_engine_create_xlib`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
+// `softshadow_engine_create_window`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
 // has no area and the frame was skipped. Its pass times arrive a frame or two later.
 //
 // # Safety
@@ -242,7 +265,7 @@ enum softshadow_status softshadow_present(struct softshadow_engine *engine,
                                           uint32_t *out_shown);
 
 // The size of the swapchain the last presented frame went to (an engine made by
-// `softshadow_engine_create_xlib`), into `*out_width` and `*out_height`; 0×0 before any.
+// `softshadow_engine_create_window`), into `*out_width` and `*out_height`; 0×0 before any.
 //
 // # Safety
 // `engine` is a live handle; the outputs are writable.
@@ -274,6 +297,15 @@ enum softshadow_status softshadow_record(struct softshadow_engine *engine,
                                          const struct softshadow_scene *scene,
                                          const struct softshadow_embedded_frame *frame,
                                          struct softshadow_recorded *recorded);
+
+// Forgets the frame `softshadow_record` recorded last, which the embedder will never submit
+// (it resets or frees the command buffer instead): the next `softshadow_record` uploads again
+// what that frame uploaded. Only right after that `softshadow_record`, before any other frame
+// (`SOFTSHADOW_ERROR_INVALID` otherwise).
+//
+// # Safety
+// `engine` is a live handle.
+enum softshadow_status softshadow_discard_recorded(struct softshadow_engine *engine);
 
 // Copies the pass times of the newest finished frame into `passes` (room for `capacity`) and
 // their number into `count`; `count` is 0 before any frame has finished.

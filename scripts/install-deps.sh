@@ -4,11 +4,11 @@
 # (libshaderc-dev with the glslang and SPIRV-Tools archives it links against); DejaVu Sans for
 # the plots of `softshadow bench`; valgrind, which tests/c_abi.rs runs the C bad-calls program under;
 # twm and xprop (x11-utils), with which tests/window.rs iconifies its window under Xvfb; the Xlib
-# headers (libx11-dev) for the C program that opens its own window there.
+# and xcb headers (libx11-dev, libxcb1-dev) for the C program that opens its own window there.
 set -euo pipefail
 packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers
           libshaderc-dev glslang-dev spirv-tools pkg-config fonts-dejavu-core
-          libx11-6 libx11-dev libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb
+          libx11-6 libx11-dev libxcb1-dev libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0 xvfb
           valgrind twm x11-utils)
 missing=()
 for p in "${packages[@]}"; do

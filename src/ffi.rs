@@ -9,8 +9,6 @@
 //! `max_len` bytes and UTF-8, or the call fails. Vulkan handles cross as `void *` (dispatchable)
 //! and `uint64_t` (non-dispatchable), so the header needs no Vulkan header.
 //!
-//! The windowed engine (from a native window handle) belongs to the window issue; it is not here.
-//!
 //! Every `unsafe` here dereferences a pointer the C caller handed in, under the contract each
 //! function's documentation states.
 
@@ -18,7 +16,9 @@
 
 use std::cell::RefCell;
 use std::ffi::{c_char, c_ulong, c_void};
+use std::num::{NonZeroIsize, NonZeroU32};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::ptr::NonNull;
 use std::sync::Arc;
 
 use ash::vk;
@@ -26,7 +26,7 @@ use glam::{Mat4, Vec3};
 
 use crate::error::Error;
 use crate::geometry::Projection;
-use crate::gpu::{Access, ContextOptions, EmbedderHandles};
+use crate::gpu::{Access, ContextOptions, EmbedderHandles, NativeWindow};
 use crate::renderer::{
     EmbeddedFrame, EmbedderCamera, EmbedderImage, Engine, FrameSettings, FrameTimings, Presented, WindowOptions,
 };
@@ -143,8 +143,8 @@ pub struct softshadow_pass_time {
 /// device (created with `softshadow_required_device_extension` and the Vulkan 1.3 features
 /// dynamicRendering, synchronization2 and maintenance4), a queue of `queue_family`, and
 /// optionally the embedder's `VkAllocationCallbacks` (NULL: none), copied at creation and passed
-/// to every `vkCreate*` / `vkDestroy*` of the engine's objects: its functions and user data must
-/// outlive the engine. Device memory blocks are allocated without them.
+/// to every `vkCreate*` / `vkDestroy*` of the engine's objects and to the `vkAllocateMemory` /
+/// `vkFreeMemory` of its device memory: its functions and user data must outlive the engine.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]
 pub struct softshadow_vulkan {
@@ -370,27 +370,99 @@ pub extern "C" fn softshadow_engine_create_headless(
     })
 }
 
-/// Creates an engine on a device of its own that presents to the embedder's Xlib `window` on
-/// `display` (`Display*` and `Window`), FIFO, at the window's size; `validation` as for
-/// `softshadow_engine_create_headless`. Present frames with `softshadow_present`.
+/// The window systems a `softshadow_native_window` can name.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum softshadow_window_kind {
+    SOFTSHADOW_WINDOW_XLIB = 1,
+    SOFTSHADOW_WINDOW_XCB = 2,
+    SOFTSHADOW_WINDOW_WAYLAND = 3,
+    SOFTSHADOW_WINDOW_WIN32 = 4,
+}
+
+/// A window the embedder owns, by its native handles. `kind` is a `softshadow_window_kind`;
+/// the other fields, by kind (a field the kind does not use must be 0 / NULL):
+/// - XLIB: `display` the `Display *`, `window` the `Window`;
+/// - XCB: `display` the `xcb_connection_t *`, `window` the `xcb_window_t`;
+/// - WAYLAND: `display` the `struct wl_display *`, `surface` the `struct wl_surface *`;
+/// - WIN32: `surface` the `HWND`, `display` its `HINSTANCE` (may be NULL).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct softshadow_native_window {
+    pub kind: u32,
+    pub display: *mut c_void,
+    pub window: u64,
+    pub surface: *mut c_void,
+}
+
+/// The window `w` describes, its fields checked against its kind.
+fn native_window(w: &softshadow_native_window) -> Result<NativeWindow, Failure> {
+    use softshadow_window_kind::*;
+    let kinds = [SOFTSHADOW_WINDOW_XLIB, SOFTSHADOW_WINDOW_XCB, SOFTSHADOW_WINDOW_WAYLAND, SOFTSHADOW_WINDOW_WIN32];
+    let kind = kinds.into_iter().find(|&k| k as u32 == w.kind).ok_or_else(|| {
+        invalid(format!("window kind {} is none of XLIB (1), XCB (2), WAYLAND (3), WIN32 (4)", w.kind))
+    })?;
+    let name = format!("{kind:?}").trim_start_matches("SOFTSHADOW_WINDOW_").to_lowercase();
+    let null = |field: &str| Failure(SOFTSHADOW_ERROR_NULL, format!("the {name} window's {field} is NULL (0)"));
+    let unused = |field: &str| invalid(format!("the {name} window does not use `{field}`: it must be 0 (NULL)"));
+    let display = NonNull::new(w.display);
+    let surface = NonNull::new(w.surface);
+    Ok(match kind {
+        SOFTSHADOW_WINDOW_XLIB | SOFTSHADOW_WINDOW_XCB => {
+            if surface.is_some() {
+                return Err(unused("surface"));
+            }
+            let display = display.ok_or_else(|| null("display"))?;
+            if w.window == 0 {
+                return Err(null("window"));
+            }
+            if kind == SOFTSHADOW_WINDOW_XLIB {
+                let window = c_ulong::try_from(w.window).map_err(|_| invalid("the xlib window is not an XID"))?;
+                NativeWindow::Xlib { display, window }
+            } else {
+                let window = u32::try_from(w.window).ok().and_then(NonZeroU32::new);
+                NativeWindow::Xcb {
+                    connection: display,
+                    window: window.ok_or_else(|| invalid("the xcb window is not a 32-bit xcb_window_t"))?,
+                }
+            }
+        }
+        SOFTSHADOW_WINDOW_WAYLAND | SOFTSHADOW_WINDOW_WIN32 => {
+            if w.window != 0 {
+                return Err(unused("window"));
+            }
+            let surface = surface.ok_or_else(|| null("surface"))?;
+            if kind == SOFTSHADOW_WINDOW_WAYLAND {
+                NativeWindow::Wayland { display: display.ok_or_else(|| null("display"))?, surface }
+            } else {
+                let as_isize = |p: NonNull<c_void>| NonZeroIsize::new(p.as_ptr() as isize).expect("non-NULL");
+                NativeWindow::Win32 { hinstance: display.map(as_isize), hwnd: as_isize(surface) }
+            }
+        }
+    })
+}
+
+/// Creates an engine on a device of its own that presents to the embedder's native window
+/// (Xlib, xcb, Wayland or Win32), FIFO, at the window's size; `validation` as for
+/// `softshadow_engine_create_headless`. Present frames with `softshadow_present`. A window
+/// system whose surface extension the Vulkan loader lacks is refused
+/// (`SOFTSHADOW_ERROR_DEVICE`, the extension named).
 ///
 /// # Safety
-/// `display` is an open display and `window` a window on it; both outlive the engine.
+/// `window` is NULL or points at a description whose handles are valid (an open display or
+/// connection, a live window or surface on it); they outlive the engine.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn softshadow_engine_create_xlib(
-    display: *mut c_void,
-    window: c_ulong,
+pub unsafe extern "C" fn softshadow_engine_create_window(
+    window: *const softshadow_native_window,
     validation: u32,
     out_engine: *mut *mut softshadow_engine,
 ) -> softshadow_status {
     guard(|| {
-        if display.is_null() {
-            return Err(Failure(SOFTSHADOW_ERROR_NULL, "display is NULL".into()));
-        }
+        let window = native_window(non_null(window, "window")?)?;
         non_null_mut(out_engine, "out_engine")?;
         let options = ContextOptions { validation: validation != 0, ..ContextOptions::from_env() };
         // SAFETY: the caller's contract, passed on.
-        let engine = unsafe { Engine::from_xlib(&options, display, window, WindowOptions::default()) }?;
+        let engine = unsafe { Engine::from_native(&options, window, WindowOptions::default()) }?;
         new_engine(engine, out_engine)
     })
 }
@@ -554,7 +626,7 @@ fn frame_of(
 }
 
 /// Renders one frame of `scene` at the window's size and presents it (an engine made by
-/// `softshadow_engine_create_xlib`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
+/// `softshadow_engine_create_window`); `*out_shown` (if not NULL) becomes 1, or 0 when the window
 /// has no area and the frame was skipped. Its pass times arrive a frame or two later.
 ///
 /// # Safety
@@ -576,7 +648,7 @@ pub unsafe extern "C" fn softshadow_present(
 }
 
 /// The size of the swapchain the last presented frame went to (an engine made by
-/// `softshadow_engine_create_xlib`), into `*out_width` and `*out_height`; 0×0 before any.
+/// `softshadow_engine_create_window`), into `*out_width` and `*out_height`; 0×0 before any.
 ///
 /// # Safety
 /// `engine` is a live handle; the outputs are writable.
@@ -589,7 +661,10 @@ pub unsafe extern "C" fn softshadow_window_size(
     guard(|| {
         let e = non_null(engine, "engine")?;
         let stats = e.engine.window_stats().ok_or_else(|| {
-            Failure(SOFTSHADOW_ERROR_INVALID, "the engine has no window (made by softshadow_engine_create_xlib)".into())
+            Failure(
+                SOFTSHADOW_ERROR_INVALID,
+                "the engine has no window (made by softshadow_engine_create_window)".into(),
+            )
         })?;
         out(out_width, stats.width, "out_width")?;
         out(out_height, stats.height, "out_height")
@@ -706,6 +781,22 @@ pub unsafe extern "C" fn softshadow_record(
             visibility_view: r.visibility_view.as_raw(),
         };
         out(recorded, result, "recorded")
+    })
+}
+
+/// Forgets the frame `softshadow_record` recorded last, which the embedder will never submit
+/// (it resets or frees the command buffer instead): the next `softshadow_record` uploads again
+/// what that frame uploaded. Only right after that `softshadow_record`, before any other frame
+/// (`SOFTSHADOW_ERROR_INVALID` otherwise).
+///
+/// # Safety
+/// `engine` is a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn softshadow_discard_recorded(engine: *mut softshadow_engine) -> softshadow_status {
+    guard(|| {
+        let e = non_null_mut(engine, "engine")?;
+        e.engine.discard_recorded()?;
+        Ok(())
     })
 }
 

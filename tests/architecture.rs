@@ -21,12 +21,13 @@ const ROOMS: &[(&str, &[&str])] = &[
 ];
 
 /// The `unsafe` allowed above gpu: the embedder's promise about its raw handles, passed on by
-/// `Engine::from_handles` to `Context::from_handles` (which makes the only Vulkan calls on them).
+/// `Engine::from_handles` to `Context::from_handles` and by `Engine::from_native` to
+/// `Context::native` (which make the only Vulkan calls on them).
 const UNSAFE_ALLOWED: &[(&str, &str)] = &[
     ("renderer/mod.rs", "pub unsafe fn from_handles(handles: EmbedderHandles)"),
     ("renderer/mod.rs", "Engine::on(unsafe { Context::from_handles(handles) }?)"),
-    ("renderer/window.rs", "pub unsafe fn from_xlib("),
-    ("renderer/window.rs", "Engine::on(unsafe { Context::xlib(options, display, window) }?)"),
+    ("renderer/window.rs", "pub unsafe fn from_native("),
+    ("renderer/window.rs", "Engine::on(unsafe { Context::native(options, window) }?)"),
 ];
 
 /// The crate-level paths each file of `dir` imports, keyed by file.

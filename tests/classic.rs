@@ -121,9 +121,10 @@ fn concentric_has_its_stated_faults() {
     let thin = "[[object]]\nshape = \"box\"\nsize = [0.01, 2.0, 1.0]\nposition = [0.0, 1.0, 0.0]\n";
     let s = top_down(-1.0, 1.0, [3.0, 3.0, 0.0], 0.5, thin);
     let (c, truth) = (render_with(&mut e, &s, "concentric", &[], WALL_SIZE), reference(&mut e, &s, WALL_SIZE));
-    // Column 126 is 3 cm behind the wall.
+    // Column 126 is 3 cm behind the wall; V counts the 8 projections that miss it, which a
+    // sub-texel change of the texture's window moves by one.
     let (v, t) = (c.visibility_at(126, 64), truth.visibility_at(126, 64));
-    assert!(t < 0.05 && v > 0.2, "at the wall's foot: concentric {v}, reference {t}");
+    assert!(t < 0.05 && v > 0.1, "at the wall's foot: concentric {v}, reference {t}");
     let s = wall(1.0, 0.5);
     let (c, truth) = (render_with(&mut e, &s, "concentric", &[], WALL_SIZE), reference(&mut e, &s, WALL_SIZE));
     // Scaling about the light's foot leaves edges that point at it hard: the wall's side edges.

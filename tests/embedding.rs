@@ -785,6 +785,46 @@ fn recording_over_an_unfinished_frame_is_an_error() {
     e.finish();
 }
 
+/// A frame the embedder records and then drops unsubmitted (its command buffer reset, the
+/// engine told by `discard_recorded`) never ran its uploads, so the next frame makes them again:
+/// for a smoothie with GPU silhouettes, the first frame ever (uploading the scene's meshes and
+/// the silhouette data) and then a frame showing new meshes, each discarded and recorded again,
+/// give the V of a fresh engine's own path to within 1 LSB, with no validation error. Only the
+/// frame recorded last can be discarded, once.
+#[test]
+fn a_discarded_frame_uploads_again_in_the_next() {
+    let e = embedder();
+    let mut engine = engine_on(&e);
+    let why = engine.discard_recorded().expect_err("nothing recorded").to_string();
+    assert!(why.contains("no frame to discard"), "{why}");
+    let mut p = params("smoothie");
+    p.set("gpu_silhouettes", "1").unwrap();
+    for box_x in [0.0, 0.5] {
+        // Parsed again: new meshes, which no frame has uploaded.
+        let s = scene(box_x);
+        let cam = engines_camera(&s);
+        let mut frames = Frames::new(&e, vk::Format::D32_SFLOAT, true);
+        frames.draw_depth(&e, &s, &cam);
+        let shot = Shot { scene: &s, params: &p, camera: cam, box_x };
+        e.begin(frames.cmd);
+        frames.record(&e, &mut engine, &shot, frames.cmd).unwrap();
+        unsafe { e.device.reset_command_buffer(frames.cmd, vk::CommandBufferResetFlags::empty()) }.unwrap();
+        engine.discard_recorded().unwrap();
+        assert!(engine.discard_recorded().is_err(), "a frame discarded twice");
+        let embedded = frames.run(&e, &mut engine, &shot).unwrap();
+        let mut fresh = engine_on(&e);
+        let mut settings = common::settings(&s, SIDE, SIDE);
+        settings.params = p.clone();
+        let own = fresh.render_and_capture(&s, &settings).unwrap().visibility;
+        drop(fresh);
+        let (over, max) = differences(&embedded, &own, 1);
+        assert!(over == 0, "box at {box_x}: {over} pixels differ by more than 1 LSB (max {max})");
+        frames.destroy(&e);
+    }
+    drop(engine);
+    e.finish();
+}
+
 /// A device created without what the engine needs is refused, the missing piece named.
 #[test]
 fn an_embedders_device_without_what_the_engine_needs_is_refused_by_name() {
@@ -878,9 +918,27 @@ unsafe extern "system" fn reallocate(
     moved
 }
 
-/// The embedder's host allocator is used for the engine's objects, and everything allocated
-/// through it is freed once the engine is dropped; the validation layer (the embedder's
-/// messenger) would report any object destroyed with other callbacks than it was made with.
+/// Host blocks alive through `host`'s callbacks while `ctx` holds a buffer of `size` bytes,
+/// less those alive before it.
+fn host_blocks_of_a_buffer(host: &HostAllocations, ctx: &softshadow::gpu::Context, size: u64) -> usize {
+    let live = || host.live.lock().unwrap().len();
+    let before = live();
+    let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let buffer =
+        softshadow::gpu::Buffer::new(ctx, "host blocks", size, usage, gpu_allocator::MemoryLocation::CpuToGpu).unwrap();
+    let during = live();
+    buffer.destroy(ctx);
+    assert_eq!(live(), before, "a buffer's host blocks outlive it");
+    during - before
+}
+
+/// The embedder's host allocator is used for the engine's objects and its device memory, and
+/// everything allocated through it is freed once the engine is dropped; the validation layer
+/// (the embedder's messenger) would report any object destroyed with other callbacks than it
+/// was made with. A buffer larger than gpu-allocator's 64 MiB host-visible blocks gets
+/// `VkDeviceMemory` of its own, whose host object (lavapipe allocates one per allocation) comes
+/// through the callbacks too: one host block more than a small buffer placed in a block that
+/// exists.
 #[test]
 fn the_embedders_allocation_callbacks_serve_and_are_all_freed() {
     let e = embedder();
@@ -904,6 +962,9 @@ fn the_embedders_allocation_callbacks_serve_and_are_all_freed() {
     engine.flush().unwrap();
     let made = host.made.load(std::sync::atomic::Ordering::Relaxed);
     assert!(made > 0, "no host allocation went through the embedder's callbacks");
+    let small = host_blocks_of_a_buffer(&host, engine.context(), 256);
+    let dedicated = host_blocks_of_a_buffer(&host, engine.context(), 80 << 20);
+    assert_eq!(dedicated, small + 1, "host blocks of a buffer in new device memory, and of one in a block");
     drop(engine);
     let live = host.live.lock().unwrap().len();
     assert_eq!(live, 0, "{live} of {made} blocks allocated through the callbacks outlive the engine");

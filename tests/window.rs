@@ -32,7 +32,10 @@ fn main() {
         ("the_present_mode_asked_for_is_taken", the_present_mode_asked_for_is_taken),
         ("fifo_keeps_the_cpu_within_the_frames_in_flight", fifo_keeps_the_cpu_within_the_frames_in_flight),
         ("softshadow_view_presents_and_writes_a_screenshot", softshadow_view_presents_and_writes_a_screenshot),
-        ("a_c_program_presents_into_its_own_xlib_window", a_c_program_presents_into_its_own_xlib_window),
+        (
+            "a_c_program_presents_into_its_own_xlib_and_xcb_windows",
+            a_c_program_presents_into_its_own_xlib_and_xcb_windows,
+        ),
         // Last: it brings a window manager, which then manages the window.
         ("minimising_under_a_window_manager_never_errors", minimising_under_a_window_manager_never_errors),
     ];
@@ -249,26 +252,30 @@ fn wait_for_state(app: &mut AppWindow, state: &str) {
     }
 }
 
-/// A C program opens its own Xlib window and hands `Display*` and `Window` to
-/// `softshadow_engine_create_xlib`: with validation on, every frame presents, at 96×64 and after
-/// the program shrinks the window to 48×32, no validation error is printed, and the last frame's
-/// passes have positive GPU times.
-fn a_c_program_presents_into_its_own_xlib_window(_: &mut AppWindow) {
-    let exe = common::c::compile("window_xlib", &["-lX11"]);
-    let output = std::process::Command::new(&exe)
-        .arg("scenes/default.toml")
-        .current_dir(common::c::root())
-        .output()
-        .expect("the C program runs");
-    let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
-    assert!(output.status.success(), "{stdout}\n{stderr}");
-    assert!(!stderr.contains("validation error"), "{stderr}");
-    for size in ["96x64", "48x32"] {
-        assert!(stdout.contains(&format!("window {size}: 30 of 30 frames presented at {size}")), "{stdout}");
+/// A C program opens its own window, with Xlib and then with xcb, and hands its handles to
+/// `softshadow_engine_create_window`: with validation on, every frame presents, at 96×64 and
+/// after the program shrinks the window to 48×32, no validation error is printed, and the last
+/// frame's passes have positive GPU times.
+fn a_c_program_presents_into_its_own_xlib_and_xcb_windows(_: &mut AppWindow) {
+    let exe = common::c::compile("window", &["-lX11", "-lxcb"]);
+    for library in ["xlib", "xcb"] {
+        let output = std::process::Command::new(&exe)
+            .args([library, "scenes/default.toml"])
+            .current_dir(common::c::root())
+            .output()
+            .expect("the C program runs");
+        let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+        assert!(output.status.success(), "{library}: {stdout}\n{stderr}");
+        assert!(!stderr.contains("validation error"), "{library}: {stderr}");
+        for size in ["96x64", "48x32"] {
+            let presented = format!("window {size}: 30 of 30 frames presented at {size}");
+            assert!(stdout.contains(&presented), "{library}: {stdout}");
+        }
+        let passes = common::c::passes(&stdout, "pass ");
+        assert!(!passes.is_empty() && passes.iter().all(|&(_, ms)| ms > 0.0), "{library}: {stdout}");
+        let times: Vec<_> = stdout.lines().filter(|l| l.starts_with("pass ")).collect();
+        println!("  {library}: {}", times.join(", "));
     }
-    let passes = common::c::passes(&stdout, "pass ");
-    assert!(!passes.is_empty() && passes.iter().all(|&(_, ms)| ms > 0.0), "{stdout}");
-    println!("  {}", stdout.lines().filter(|l| l.starts_with("pass ")).collect::<Vec<_>>().join(", "));
     std::fs::remove_file(exe).unwrap();
 }
 

@@ -10,16 +10,18 @@
 
 static int failures = 0;
 
-static void expect(const char *what, softshadow_status got, softshadow_status want) {
+/* `says`: text the message must contain (NULL: any message). */
+static void expect(const char *what, softshadow_status got, softshadow_status want, const char *says) {
     char message[256];
     size_t len = softshadow_last_error(message, sizeof message);
     int has_message = len > 0 && strlen(message) == (len < sizeof message ? len : sizeof message - 1);
-    int ok = got == want && (want == SOFTSHADOW_OK || has_message);
+    int ok = got == want && (want == SOFTSHADOW_OK || (has_message && (!says || strstr(message, says))));
     printf("%s %s -> %d (want %d): %s\n", ok ? "ok  " : "FAIL", what, (int)got, (int)want, message);
     failures += !ok;
 }
 
-#define EXPECT(call, want) expect(#call, (call), (want))
+#define EXPECT(call, want) expect(#call, (call), (want), NULL)
+#define EXPECT_SAYING(call, want, says) expect(#call, (call), (want), (says))
 
 /* VkAllocationCallbacks' layout, without including Vulkan's header. */
 typedef struct {
@@ -70,9 +72,35 @@ int main(void) {
     EXPECT(softshadow_scene_load("scenes/default.toml", 64, NULL), SOFTSHADOW_ERROR_NULL);
     EXPECT(softshadow_scene_create(NULL, &scene), SOFTSHADOW_ERROR_NULL);
     EXPECT(softshadow_engine_create_from_vulkan(NULL, &engine), SOFTSHADOW_ERROR_NULL);
-    EXPECT(softshadow_engine_create_xlib(NULL, 1, 0, &engine), SOFTSHADOW_ERROR_NULL);
-    int not_a_display = 0; /* never read: a window of None is refused first */
-    EXPECT(softshadow_engine_create_xlib(&not_a_display, 0, 0, &engine), SOFTSHADOW_ERROR_INVALID);
+    /* Native windows: each refused before any handle is used (the Win32 one because this
+     * loader has no VK_KHR_win32_surface, found before an instance exists). */
+    int not_a_display = 0, not_a_window = 0;
+    EXPECT(softshadow_engine_create_window(NULL, 0, &engine), SOFTSHADOW_ERROR_NULL);
+    softshadow_native_window w = {.kind = 0, .display = &not_a_display, .window = 1};
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_INVALID, "window kind 0");
+    w.kind = 99;
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_INVALID, "window kind 99");
+    w = (softshadow_native_window){.kind = SOFTSHADOW_WINDOW_XLIB, .window = 1};
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_NULL, "xlib window's display");
+    w.display = &not_a_display;
+    w.window = 0;
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_NULL, "xlib window's window");
+    w.window = 1;
+    w.surface = &not_a_window;
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_INVALID, "`surface`");
+    w = (softshadow_native_window){.kind = SOFTSHADOW_WINDOW_XCB, .display = &not_a_display, .window = 1ull << 32};
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_INVALID, "xcb_window_t");
+    w.window = 1;
+    EXPECT(softshadow_engine_create_window(&w, 0, NULL), SOFTSHADOW_ERROR_NULL);
+    w = (softshadow_native_window){.kind = SOFTSHADOW_WINDOW_WAYLAND, .display = &not_a_display};
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_NULL, "wayland window's surface");
+    w.surface = &not_a_window;
+    w.window = 1;
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_INVALID, "`window`");
+    w = (softshadow_native_window){.kind = SOFTSHADOW_WINDOW_WIN32};
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_NULL, "win32 window's surface");
+    w.surface = &not_a_window;
+    EXPECT_SAYING(softshadow_engine_create_window(&w, 0, &engine), SOFTSHADOW_ERROR_DEVICE, "VK_KHR_win32_surface");
     EXPECT(softshadow_present(NULL, NULL, NULL), SOFTSHADOW_ERROR_NULL);
     EXPECT(softshadow_window_size(NULL, NULL, NULL), SOFTSHADOW_ERROR_NULL);
     softshadow_vulkan no_device = {0};
@@ -175,6 +203,8 @@ int main(void) {
     frame.command_buffer = (void *)1;
     frame.depth.format = 37; /* VK_FORMAT_R8G8B8A8_UNORM is no depth format */
     EXPECT(softshadow_record(engine, scene, &frame, &recorded), SOFTSHADOW_ERROR_INVALID);
+    EXPECT(softshadow_discard_recorded(NULL), SOFTSHADOW_ERROR_NULL);
+    EXPECT_SAYING(softshadow_discard_recorded(engine), SOFTSHADOW_ERROR_INVALID, "no frame to discard"); /* none recorded */
 
     /* The message is truncated to the room given and terminated; its full length returned. */
     char tiny[4];

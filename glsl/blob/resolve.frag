@@ -25,7 +25,7 @@ void main() {
     }
     vec3 n = view.plane_normal.xyz;
     vec3 o = view.plane_origin.xyz;
-    if (abs(dot(s.p - o, n)) > view.plane_origin.w || dot(s.n, n) < 0.99) {
+    if (!on_plane(frame, s, o, n)) {
         out_visibility = 1.0; // off the ground: blobs fall on the ground only
         return;
     }

@@ -33,6 +33,15 @@ Surface read_surface(FrameGlobals frame, sampler2D depth_target, sampler2D norma
     return s;
 }
 
+// Whether the surface lies on the plane through `o` of unit normal `n`, and faces along it: off
+// it by no more than its reconstructed position rounds by (f32 depth and inverse view-projection:
+// a few ulps of its distance from the camera and of the camera's position). A tolerance of 1e-3
+// of the light's height took a slab 0.5 m up for the ground under any light 500 m up (issue 19).
+bool on_plane(FrameGlobals frame, Surface s, vec3 o, vec3 n) {
+    float rounding = 1e-5 * (distance(s.p, frame.camera_position.xyz) + length(frame.camera_position.xyz));
+    return abs(dot(s.p - o, n)) <= rounding && dot(s.n, n) >= 0.99;
+}
+
 // A caster's own surface hides whatever lies behind its tangent plane: a point q of the light
 // there is blocked whatever a shadow map says (rays from the camera's side cross the surface).
 bool hides_itself(Surface s, vec3 q) {

@@ -47,7 +47,7 @@ struct LightSample {
 // The plateau texture's frame (Haines): the receiver plane, in-plane axes, the window.
 struct PlateauView {
     mat4 umbra;         // world -> plateau clip: window * plane coordinates * Blinn, z = 0 (hither)
-    vec4 plane_origin;  // xyz; w = how far off the plane a surface may be and still be on it
+    vec4 plane_origin;  // xyz; w unused (on_plane, camera.glsl, says what is on it)
     vec4 plane_normal;  // xyz; w unused
     vec4 plane_u;       // xyz; w unused
     vec4 plane_v;       // xyz
@@ -91,7 +91,7 @@ struct SampleView {
 
 // The classic systems' frame (blob, concentric, projective texture).
 struct ClassicView {
-    vec4 plane_origin;  // xyz; w = how far off the plane a surface may be and still be on it
+    vec4 plane_origin;  // xyz; w unused (on_plane, camera.glsl, says what is on it)
     vec4 plane_normal;  // xyz
     vec4 plane_u;       // xyz
     vec4 plane_v;       // xyz

@@ -58,17 +58,21 @@ void main() {
     }
     vec3 n = plateau.plane_normal.xyz;
     vec3 o = plateau.plane_origin.xyz;
-    float h = dot(s.p - o, n);
     vec3 q = s.p;
-    if (abs(h) > plateau.plane_origin.w || dot(s.n, n) < 0.99) {
+    if (!on_plane(frame, s, o, n)) {
         // Off the plane: unshadowed, or (mode 1, receivers that cast nothing) the paper's
         // projected light map: the texture where the ray from the light through p meets the plane.
+        float h = dot(s.p - o, n);
         float hl = dot(frame.light.xyz - o, n);
         if (!OFF_PLANE_MAP || s.casts || h >= hl) {
             out_visibility = 1.0;
             return;
         }
-        q = frame.light.xyz + (s.p - frame.light.xyz) * (hl / (hl - h));
+        // From p along the ray, not from the light: light + (p − light)·hl/(hl − h) rounds p
+        // to the ulp of the light's position (8 m from 1e8 m). The true light, not the nearer
+        // one the texture is drawn from: their rays differ by at most 1/256 rad.
+        vec3 d = s.p - frame.light.xyz;
+        q = s.p - d * (h / dot(d, n));
     }
     vec2 uv = vec2(dot(q - o, plateau.plane_u.xyz), dot(q - o, plateau.plane_v.xyz));
     vec2 tc = (uv - plateau.window.xy) / (plateau.window.zw - plateau.window.xy);

@@ -74,52 +74,132 @@ void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner) {
 
 const Inner OUTER = Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(0.0));
 
-void main() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= params.counts.x) {
-        return;
-    }
+// Two dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex: PAIRING
+// counts each silhouette vertex's edge ends (stamped, so no clear is needed) and keeps the first
+// two; then each vertex's first end draws its corner, a wedge from both ends' sides where
+// exactly two meet, else a full square.
+layout(constant_id = 1) const bool PAIRING = true;
+
+// A silhouette edge in the light view: its ends, their depths, and where it is not edge-on its
+// outward normal (`sided`).
+struct Silhouette {
+    uvec2 v;
+    vec2 t[2];
+    float z[2];
+    bool sided;
+    vec2 along;
+    vec2 normal;
+};
+
+bool silhouette(uint i, out Silhouette s) {
     uvec4 e = edges[i];
     bool l0 = lit(e.z), l1 = lit(e.w);
     if (l0 == l1) {
-        return;
+        return false;
     }
     uvec4 face = triangles[l0 ? e.z : e.w];
     uint inner = face.x != e.x && face.x != e.y ? face.x : (face.y != e.x && face.y != e.y ? face.y : face.z);
     vec3 pa = view_position(e.x), pb = view_position(e.y), pi = view_position(inner);
     if (pa.z <= MIN_DEPTH || pb.z <= MIN_DEPTH) {
-        return;
+        return false;
     }
-    vec2 ta = pa.xy / pa.z, tb = pb.xy / pb.z;
-    // One corner per silhouette vertex: the first edge to stamp it this frame draws it.
-    uint vs[2] = uint[2](e.x, e.y);
-    vec2 tv[2] = vec2[2](ta, tb);
-    float zv[2] = float[2](pa.z, pb.z);
-    for (int k = 0; k < 2; k++) {
-        if (atomicExchange(stamps[vs[k]], params.counts.y) != params.counts.y) {
-            float r = smoothie_t(zv[k]) * reach(zv[k]);
-            float kk = reach(zv[k]);
-            vec2 c[4] = vec2[4](vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1));
-            vec2 q[4] = vec2[4](tv[k] + c[0] * r, tv[k] + c[1] * r, tv[k] + c[2] * r, tv[k] + c[3] * r);
-            float b[4] = float[4](zv[k], zv[k], zv[k], zv[k]);
-            vec2 s[4] = vec2[4](c[0] * kk, c[1] * kk, c[2] * kk, c[3] * kk);
-            quad(q, b, s, OUTER);
+    s.v = e.xy;
+    s.t = vec2[2](pa.xy / pa.z, pb.xy / pb.z);
+    s.z = float[2](pa.z, pb.z);
+    vec2 along = s.t[1] - s.t[0];
+    s.sided = dot(along, along) != 0.0 && pi.z > MIN_DEPTH;
+    s.along = s.sided ? normalize(along) : vec2(0.0);
+    vec2 perp = vec2(-s.along.y, s.along.x);
+    s.normal = dot(perp, pi.xy / pi.z - s.t[0]) > 0.0 ? -perp : perp;
+    return true;
+}
+
+// The stamped count word of vertex v: this frame's count in the low two bits (saturating).
+uint arrive(uint v) {
+    uint stamp = params.counts.y << 2u;
+    uint old = stamps[3u * v];
+    for (;;) {
+        uint n = (old & ~3u) == stamp ? old & 3u : 0u;
+        uint seen = atomicCompSwap(stamps[3u * v], old, stamp | min(n + 1u, 3u));
+        if (seen == old) {
+            return n;
+        }
+        old = seen;
+    }
+}
+
+void corner_quad(vec2 p, float z, float t, vec2 o[4]) {
+    vec2 q[4] = vec2[4](p + o[0] * t, p + o[1] * t, p + o[2] * t, p + o[3] * t);
+    quad(q, float[4](z, z, z, z), o, OUTER);
+}
+
+// The corner at end k of silhouette s, given the vertex's end count and its other end.
+void corner(Silhouette s, int k, uint count, uint other) {
+    vec2 p = s.t[k];
+    float z = s.z[k], t = smoothie_t(z), kk = reach(z);
+    Silhouette o;
+    if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
+        vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
+        vec2 d2 = (other & 1u) == 0u ? o.along : -o.along, n2 = o.normal;
+        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square.
+        vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
+        bool consistent = dot(p1, n1) * dot(p2, n2) > 0.0;
+        bool concave = dot(n1, d2) >= 0.0;
+        if (consistent && concave && params.counts.w == 0u) {
+            return; // concave or straight: the two edges' quads overlap
+        }
+        vec2 m = n1 + n2;
+        if (consistent && !concave && dot(m, m) > 0.0) {
+            m = normalize(m);
+            vec2 ns[2] = vec2[2](n1, n2);
+            for (int j = 0; j < 2; j++) {
+                vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
+                corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk));
+            }
+            if (params.counts.w != 0u) {
+                // Centred: the square's inner half too, as src/geometry/smoothie.rs.
+                vec2 across = vec2(-m.y, m.x) * kk;
+                corner_quad(p, z, t, vec2[4](across, across - m * kk, -across - m * kk, -across));
+            }
+            return;
         }
     }
-    vec2 along = tb - ta;
-    if (dot(along, along) == 0.0 || pi.z <= MIN_DEPTH) {
+    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)));
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    Silhouette s;
+    if (i >= params.counts.x || !silhouette(i, s)) {
         return;
     }
-    along = normalize(along);
-    vec2 perp = vec2(-along.y, along.x);
-    vec2 normal = dot(perp, pi.xy / pi.z - ta) > 0.0 ? -perp : perp;
-    float ka = reach(pa.z), kb = reach(pb.z);
-    vec2 da = normal * smoothie_t(pa.z) * ka, db = normal * smoothie_t(pb.z) * kb;
-    float b[4] = float[4](pa.z, pb.z, pb.z, pa.z);
-    vec2 s[4] = vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0));
-    quad(vec2[4](ta, tb, tb + db, ta + da), b, s, OUTER);
+    if (PAIRING) {
+        for (uint k = 0u; k < 2u; k++) {
+            uint n = arrive(s.v[k]);
+            if (n < 2u) {
+                stamps[3u * s.v[k] + 1u + n] = 2u * i + k;
+            }
+        }
+        return;
+    }
+    for (int k = 0; k < 2; k++) {
+        uint v = s.v[k];
+        if (stamps[3u * v + 1u] == 2u * i + uint(k)) {
+            corner(s, k, stamps[3u * v] & 3u, stamps[3u * v + 2u]);
+        }
+    }
+    if (!s.sided) {
+        return;
+    }
+    float za = s.z[0], zb = s.z[1];
+    vec2 ta = s.t[0], tb = s.t[1], normal = s.normal;
+    float ka = reach(za), kb = reach(zb);
+    vec2 da = normal * smoothie_t(za) * ka, db = normal * smoothie_t(zb) * kb;
+    float b[4] = float[4](za, zb, zb, za);
+    vec2 sh[4] = vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0));
+    quad(vec2[4](ta, tb, tb + db, ta + da), b, sh, OUTER);
     if (params.counts.w != 0u) {
         // The inner quad, mirrored over the blocker (issue 20).
-        quad(vec2[4](ta, tb, tb - db, ta - da), b, s, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw));
+        quad(vec2[4](ta, tb, tb - db, ta - da), b, sh, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw));
     }
 }

@@ -30,7 +30,8 @@ pub struct EdgeAdjacency {
     /// boundary edge of that face, so that silhouette tests stay conservative.
     pub edges: Vec<Edge>,
     /// `edges[i].faces`, apart: what silhouette extraction streams through every frame, half
-    /// the bytes of `edges`.
+    /// the bytes of `edges`. Here a missing face is the face count, not [`NO_FACE`]: the index of
+    /// the always unlit flag that ends a [`Facing`](super::silhouette::Facing).
     pub face_pairs: Vec<[u32; 2]>,
     /// Edges with exactly one face.
     pub boundary: usize,
@@ -70,7 +71,8 @@ impl EdgeAdjacency {
                 }
             }
         }
-        adjacency.face_pairs = adjacency.edges.iter().map(|e| e.faces).collect();
+        let missing = triangles.len() as u32;
+        adjacency.face_pairs = adjacency.edges.iter().map(|e| e.faces.map(|f| f.min(missing))).collect();
         adjacency
     }
 

@@ -2,6 +2,7 @@
 //! synchronization2, push descriptors for every pass, validation on request; on a device of our
 //! own, or on the embedder's.
 
+use std::cell::Cell;
 use std::ffi::{CStr, c_char};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -77,8 +78,8 @@ pub struct EmbedderHandles {
     /// [`required_core_features`](super::required_core_features).
     pub enabled_core_features: vk::PhysicalDeviceFeatures,
     /// The embedder's host allocator, passed to every `vkCreate*` and `vkDestroy*` of the engine's
-    /// own objects (its functions and user data must outlive the engine). Device memory comes
-    /// from gpu-allocator, whose `vkAllocateMemory` and `vkFreeMemory` pass none.
+    /// own objects and to gpu-allocator's `vkAllocateMemory` and `vkFreeMemory` (its functions
+    /// and user data must outlive the engine).
     pub allocation_callbacks: Option<vk::AllocationCallbacks<'static>>,
 }
 
@@ -98,6 +99,9 @@ pub struct Context {
     ownership: Ownership,
     /// The embedder's host allocator, if it gave one.
     host_allocator: Option<vk::AllocationCallbacks<'static>>,
+    /// What gpu-allocator's device memory calls substitute while this context calls into it:
+    /// set only with a host allocator.
+    host_memory: Option<HostMemory>,
     // `None` only after `destroy`.
     allocator: Option<Mutex<Allocator>>,
     live_allocations: AtomicUsize,
@@ -124,7 +128,16 @@ struct Retired {
     /// Frames recorded so far: submitted, or recorded into the embedder's command buffer.
     recorded: u64,
     items: Vec<(u64, Destroyer)>,
+    /// Whether the frame begun last has not been recorded yet.
+    open: bool,
+    /// Frames lost so far: begun but never recorded (an error), or discarded by the embedder.
+    lost: u64,
 }
+
+/// When data was uploaded by copies recorded into a frame ([`Context::upload_mark`]): the
+/// frames lost before it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UploadMark(u64);
 
 /// Destroys one retired object.
 type Destroyer = Box<dyn FnOnce(&Context)>;
@@ -337,6 +350,7 @@ impl Context {
             queue_family: parts.queue_family,
             ownership: parts.ownership,
             host_allocator: parts.host_allocator,
+            host_memory: None,
             allocator: None,
             live_allocations: AtomicUsize::new(0),
             nearest_sampler: vk::Sampler::null(),
@@ -349,9 +363,32 @@ impl Context {
             queue_waits: AtomicU64::new(0),
             window: None,
         };
+        // gpu-allocator passes no host allocator to vkAllocateMemory and vkFreeMemory: with one,
+        // it gets a device whose two entries are shims that pass ours.
+        ctx.host_memory = ctx.host_allocator.map(|callbacks| HostMemory {
+            callbacks,
+            allocate: ctx.device.fp_v1_0().allocate_memory,
+            free: ctx.device.fp_v1_0().free_memory,
+        });
+        let allocator_device = match ctx.host_memory {
+            Some(_) => {
+                let mut v1_0 = ctx.device.fp_v1_0().clone();
+                v1_0.allocate_memory = allocate_memory_with_host_allocator;
+                v1_0.free_memory = free_memory_with_host_allocator;
+                let d = &ctx.device;
+                ash::Device::from_parts_1_3(
+                    d.handle(),
+                    v1_0,
+                    d.fp_v1_1().clone(),
+                    d.fp_v1_2().clone(),
+                    d.fp_v1_3().clone(),
+                )
+            }
+            None => ctx.device.clone(),
+        };
         ctx.allocator = Some(Mutex::new(Allocator::new(&AllocatorCreateDesc {
             instance: ctx.instance.clone(),
-            device: ctx.device.clone(),
+            device: allocator_device,
             physical_device: physical,
             debug_settings: Default::default(),
             buffer_device_address: false,
@@ -412,15 +449,20 @@ impl Context {
         self.live_allocations.load(Ordering::Relaxed)
     }
 
-    fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
-        self.allocator.as_ref().expect("allocator used after destroy").lock().expect("allocator lock")
+    /// Runs `f`, a call into gpu-allocator, with this context's host allocator in force for
+    /// the device memory it allocates or frees.
+    fn with_allocator<R>(&self, f: impl FnOnce(&mut Allocator) -> R) -> R {
+        let mut allocator =
+            self.allocator.as_ref().expect("allocator used after destroy").lock().expect("allocator lock");
+        let _scope = HostMemoryScope::enter(self.host_memory);
+        f(&mut allocator)
     }
 
     pub(crate) fn allocate(
         &self,
         desc: &gpu_allocator::vulkan::AllocationCreateDesc<'_>,
     ) -> Result<gpu_allocator::vulkan::Allocation> {
-        let allocation = self.allocator().allocate(desc)?;
+        let allocation = self.with_allocator(|a| a.allocate(desc))?;
         self.live_allocations.fetch_add(1, Ordering::Relaxed);
         Ok(allocation)
     }
@@ -428,7 +470,7 @@ impl Context {
     pub(crate) fn free(&self, allocation: gpu_allocator::vulkan::Allocation) {
         self.live_allocations.fetch_sub(1, Ordering::Relaxed);
         // Freeing only fails for a foreign allocation, which this crate never makes.
-        if let Err(e) = self.allocator().free(allocation) {
+        if let Err(e) = self.with_allocator(|a| a.free(allocation)) {
             eprintln!("softshadow: freeing GPU memory failed: {e}");
         }
     }
@@ -473,9 +515,41 @@ impl Context {
         self.retired.lock().expect("retire list").recorded
     }
 
+    /// A frame begins recording; the one begun before it, if never recorded, is lost.
+    pub(super) fn frame_begun(&self) {
+        let mut r = self.retired.lock().expect("retire list");
+        r.lost += u64::from(r.open);
+        r.open = true;
+    }
+
     /// A frame has been recorded (submitted, or handed to the embedder to submit).
     pub(super) fn frame_recorded(&self) {
-        self.retired.lock().expect("retire list").recorded += 1;
+        let mut r = self.retired.lock().expect("retire list");
+        r.recorded += 1;
+        r.open = false;
+    }
+
+    /// The frame recorded last was discarded by the embedder: it never runs, so it does not
+    /// count (what was retired meanwhile waits for frames that do), and it is lost.
+    pub(super) fn frame_discarded(&self) {
+        let mut r = self.retired.lock().expect("retire list");
+        r.recorded -= 1;
+        r.lost += 1;
+    }
+
+    /// The mark of data uploaded (or computed) by copies recorded into the frame being
+    /// recorded, for [`Context::upload_kept`].
+    pub fn upload_mark(&self) -> UploadMark {
+        UploadMark(self.retired.lock().expect("retire list").lost)
+    }
+
+    /// Whether data marked `mark` is (or will be, once the frames recorded so far run) on the
+    /// GPU: no frame has been lost since it was uploaded, so the frame that uploaded it is the
+    /// one being recorded or was recorded (frames are lost only between frames). After a lost
+    /// frame every earlier upload counts as lost too: uploading again is cheaper than
+    /// remembering which frame was lost.
+    pub fn upload_kept(&self, mark: UploadMark) -> bool {
+        mark.0 == self.retired.lock().expect("retire list").lost
     }
 
     /// Destroys what was retired before the frames now known finished: called as frame n
@@ -513,7 +587,11 @@ impl Context {
             let _ = self.device.queue_wait_idle(self.queue);
             self.destroy_retired();
             self.device.destroy_sampler(self.nearest_sampler, self.host_allocator());
-            self.allocator = None;
+            // Dropping the allocator frees its memory blocks.
+            if let Some(allocator) = self.allocator.take() {
+                let _scope = HostMemoryScope::enter(self.host_memory);
+                drop(allocator);
+            }
             if self.ownership == Ownership::Owned {
                 self.device.destroy_device(None);
                 if let Some((loader, surface)) = self.surface.take() {
@@ -531,6 +609,69 @@ impl Context {
 impl Drop for Context {
     fn drop(&mut self) {
         self.destroy();
+    }
+}
+
+/// The embedder's host allocator and the device's own `vkAllocateMemory` and `vkFreeMemory`,
+/// for the shims gpu-allocator calls instead.
+#[derive(Clone, Copy)]
+struct HostMemory {
+    callbacks: vk::AllocationCallbacks<'static>,
+    allocate: vk::PFN_vkAllocateMemory,
+    free: vk::PFN_vkFreeMemory,
+}
+
+thread_local! {
+    /// The [`HostMemory`] of the context whose call into gpu-allocator this thread is making:
+    /// gpu-allocator keeps no user data to find it by, and calls Vulkan only from within those
+    /// calls, on the calling thread.
+    static HOST_MEMORY: Cell<Option<HostMemory>> = const { Cell::new(None) };
+}
+
+/// Sets [`HOST_MEMORY`] for its lifetime, restoring the previous value after (a panic too).
+struct HostMemoryScope(Option<HostMemory>);
+
+impl HostMemoryScope {
+    fn enter(memory: Option<HostMemory>) -> Self {
+        HostMemoryScope(HOST_MEMORY.replace(memory))
+    }
+}
+
+impl Drop for HostMemoryScope {
+    fn drop(&mut self) {
+        HOST_MEMORY.set(self.0);
+    }
+}
+
+/// gpu-allocator's `vkAllocateMemory` on a context with a host allocator: the device's own,
+/// passed the embedder's callbacks for the NULL gpu-allocator gives.
+unsafe extern "system" fn allocate_memory_with_host_allocator(
+    device: vk::Device,
+    info: *const vk::MemoryAllocateInfo<'_>,
+    allocator: *const vk::AllocationCallbacks<'_>,
+    memory: *mut vk::DeviceMemory,
+) -> vk::Result {
+    match HOST_MEMORY.get() {
+        // SAFETY: gpu-allocator's arguments, passed on; the callbacks outlive the context.
+        Some(h) => unsafe {
+            (h.allocate)(device, info, if allocator.is_null() { &h.callbacks } else { allocator }, memory)
+        },
+        // Unreachable: the allocator this device is given is only called through `with_allocator`.
+        None => vk::Result::ERROR_INITIALIZATION_FAILED,
+    }
+}
+
+/// gpu-allocator's `vkFreeMemory`, as [`allocate_memory_with_host_allocator`].
+unsafe extern "system" fn free_memory_with_host_allocator(
+    device: vk::Device,
+    memory: vk::DeviceMemory,
+    allocator: *const vk::AllocationCallbacks<'_>,
+) {
+    // Without one (unreachable, as above) the memory is leaked rather than freed with callbacks
+    // other than those it was allocated with.
+    if let Some(h) = HOST_MEMORY.get() {
+        // SAFETY: as above.
+        unsafe { (h.free)(device, memory, if allocator.is_null() { &h.callbacks } else { allocator }) }
     }
 }
 

@@ -41,6 +41,8 @@ struct External {
     next_mark: u32,
     /// The mark each slot's unfinished frame will write.
     pending: [Option<u32>; FRAMES_IN_FLIGHT],
+    /// The slot of the frame ended last, until another begins: the embedder may still discard it.
+    discardable: Option<usize>,
 }
 
 /// A frame being recorded.
@@ -110,8 +112,12 @@ impl FrameRing {
 
     /// Waits for the next slot's previous frame, returns its pass times, and starts recording.
     pub fn begin(&mut self, ctx: &Context) -> Result<(Frame<'_>, Option<Vec<PassTime>>)> {
+        if let Some(external) = &mut self.external {
+            external.discardable = None;
+        }
         let slot = self.next;
         let earlier = self.wait(ctx, slot)?;
+        ctx.frame_begun();
         ctx.destroy_finished();
         let s = &mut self.slots[slot];
         // The fence is reset only at submit: a frame abandoned on an error leaves it signalled,
@@ -139,9 +145,11 @@ impl FrameRing {
                 buffer: Buffer::new(ctx, "embedded frame progress", size, usage, MemoryLocation::GpuToCpu)?,
                 next_mark: 1,
                 pending: [None; FRAMES_IN_FLIGHT],
+                discardable: None,
             });
         }
         let external = self.external.as_mut().expect("made above");
+        external.discardable = None;
         let slot = self.next;
         let mut done = Vec::new();
         for k in 0..FRAMES_IN_FLIGHT {
@@ -171,6 +179,7 @@ impl FrameRing {
                 }
             }
         }
+        ctx.frame_begun();
         ctx.destroy_finished();
         let s = &mut self.slots[slot];
         s.timer.reset(ctx, cmd);
@@ -197,8 +206,24 @@ impl FrameRing {
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::HOST_READ);
         timer.submitted();
         external.pending[slot] = Some(mark);
+        external.discardable = Some(slot);
         self.next = (slot + 1) % FRAMES_IN_FLIGHT;
         ctx.frame_recorded();
+    }
+
+    /// Forgets the embedder's frame ended last, which the embedder will never submit: its slot
+    /// is free again, it will write no timestamps, and it no longer counts as recorded (so what
+    /// it uploaded counts as never uploaded). Only before another frame begins.
+    pub fn discard_external(&mut self, ctx: &Context) -> Result<()> {
+        let external = self.external.as_mut().filter(|e| e.discardable.is_some()).ok_or_else(|| {
+            Error::Invalid("no frame to discard: only the frame recorded last can be, before another begins".into())
+        })?;
+        let slot = external.discardable.take().expect("checked");
+        external.pending[slot] = None;
+        self.slots[slot].timer.discarded();
+        self.next = slot;
+        ctx.frame_discarded();
+        Ok(())
     }
 
     /// Ends and submits the frame begun last, waiting on and signalling `semaphores`.

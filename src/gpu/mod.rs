@@ -19,7 +19,7 @@ mod timestamps;
 mod upload;
 
 pub use barrier::{Access, BufferAccess, buffer_barrier, copy_to_host, transition};
-pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership};
+pub use context::{Context, ContextOptions, DeviceInfo, EmbedderHandles, Ownership, UploadMark};
 pub use device::{
     CreateSurface, DeviceFilter, required_core_features, required_device_extensions, required_vulkan13_features,
 };
@@ -32,7 +32,7 @@ pub use render::{
     Attachment, RenderPass, dispatch, draw_fullscreen, draw_indexed, draw_indirect, draw_vertices, fullscreen,
     update_buffer,
 };
-pub use swapchain::{Acquired, PresentMode, Swapchain, SwapchainRequest, is_srgb};
+pub use swapchain::{Acquired, NativeWindow, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
 pub use timestamps::{Milestones, PassTime, PassTimer};
 pub use upload::{Uploads, copy_to_buffer, copy_to_target, upload, upload_in};

@@ -2,11 +2,17 @@
 //! windowed contexts share one construction path (hypermine's `Base::new`), and a swapchain
 //! whose images are wrapped [`Target`]s, acquired and presented with semaphores.
 
-use std::ffi::CStr;
+use std::ffi::{CStr, c_ulong, c_void};
+use std::num::{NonZeroIsize, NonZeroU32};
+use std::ptr::NonNull;
 use std::sync::Arc;
 
 use ash::vk;
-use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use raw_window_handle::{
+    DisplayHandle, HandleError, HasDisplayHandle, HasWindowHandle, RawDisplayHandle, RawWindowHandle,
+    WaylandDisplayHandle, WaylandWindowHandle, Win32WindowHandle, WindowHandle, WindowsDisplayHandle, XcbDisplayHandle,
+    XcbWindowHandle, XlibDisplayHandle, XlibWindowHandle,
+};
 
 use super::barrier::Access;
 use super::frames::FRAMES_IN_FLIGHT;
@@ -53,7 +59,7 @@ impl Context {
     where
         W: HasDisplayHandle + HasWindowHandle + Send + Sync + 'static,
     {
-        let handle_error = |e: raw_window_handle::HandleError| Error::Window(format!("no window handle: {e}"));
+        let handle_error = |e: HandleError| Error::Window(format!("no window handle: {e}"));
         let display = window.display_handle().map_err(handle_error)?.as_raw();
         let raw = window.window_handle().map_err(handle_error)?.as_raw();
         let instance_extensions: Vec<&CStr> = ash_window::enumerate_required_extensions(display)
@@ -79,21 +85,21 @@ impl Context {
         Ok(ctx)
     }
 
-    /// A context presenting to the embedder's Xlib `window` on `display`.
+    /// A context presenting to the embedder's native `window`. A window system whose surface
+    /// extension the Vulkan loader lacks (Win32 off Windows, Wayland without a Wayland-enabled
+    /// driver) is refused, the extension named.
     ///
     /// # Safety
-    /// `display` is an open Xlib `Display*` and `window` a window on it; both outlive the context.
-    pub unsafe fn xlib(
-        options: &ContextOptions,
-        display: *mut std::ffi::c_void,
-        window: std::ffi::c_ulong,
-    ) -> Result<Context> {
-        let display =
-            std::ptr::NonNull::new(display).ok_or_else(|| Error::Invalid("the Xlib display is NULL".into()))?;
-        if window == 0 {
+    /// The handles are valid (an open display or connection, a live window or surface on it)
+    /// and outlive the context.
+    pub unsafe fn native(options: &ContextOptions, window: NativeWindow) -> Result<Context> {
+        if let NativeWindow::Xlib { window: 0, .. } = window {
             return Err(Error::Invalid("the Xlib window is None (0)".into()));
         }
-        Context::windowed(options, Arc::new(XlibWindow { display, window }))
+        Context::windowed(options, Arc::new(window)).map_err(|e| match e {
+            Error::NoDevice(why) => Error::NoDevice(format!("cannot present to the {} window: {why}", window.kind())),
+            e => e,
+        })
     }
 
     fn surface(&self) -> Result<&(ash::khr::surface::Instance, vk::SurfaceKHR)> {
@@ -329,34 +335,65 @@ fn semaphore(ctx: &Context) -> Result<vk::Semaphore> {
         .vk("vkCreateSemaphore")
 }
 
-/// A native Xlib window (`Display*`, `Window`), for the window handle traits that
-/// [`Context::windowed`] takes.
-struct XlibWindow {
-    display: std::ptr::NonNull<std::ffi::c_void>,
-    window: std::ffi::c_ulong,
+/// A window the embedder owns, by its native handles (the C ABI's `softshadow_native_window`),
+/// for the window handle traits [`Context::windowed`] takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NativeWindow {
+    /// An Xlib `Display*` and `Window`.
+    Xlib { display: NonNull<c_void>, window: c_ulong },
+    /// An `xcb_connection_t*` and `xcb_window_t`.
+    Xcb { connection: NonNull<c_void>, window: NonZeroU32 },
+    /// A `wl_display*` and `wl_surface*`.
+    Wayland { display: NonNull<c_void>, surface: NonNull<c_void> },
+    /// An `HWND` and, optionally, its `HINSTANCE`.
+    Win32 { hinstance: Option<NonZeroIsize>, hwnd: NonZeroIsize },
 }
 
-// SAFETY: only handles (a pointer and an XID) the engine hands to Vulkan, which synchronises its
-// own use of the display.
-unsafe impl Send for XlibWindow {}
-unsafe impl Sync for XlibWindow {}
-
-impl raw_window_handle::HasDisplayHandle for XlibWindow {
-    fn display_handle(
-        &self,
-    ) -> std::result::Result<raw_window_handle::DisplayHandle<'_>, raw_window_handle::HandleError> {
-        let raw = raw_window_handle::XlibDisplayHandle::new(Some(self.display), 0);
-        // SAFETY: the embedder keeps the display open while the engine lives (Context::xlib's contract).
-        Ok(unsafe { raw_window_handle::DisplayHandle::borrow_raw(raw.into()) })
+impl NativeWindow {
+    /// The window system's name, for messages.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            NativeWindow::Xlib { .. } => "Xlib",
+            NativeWindow::Xcb { .. } => "xcb",
+            NativeWindow::Wayland { .. } => "Wayland",
+            NativeWindow::Win32 { .. } => "Win32",
+        }
     }
 }
 
-impl raw_window_handle::HasWindowHandle for XlibWindow {
-    fn window_handle(
-        &self,
-    ) -> std::result::Result<raw_window_handle::WindowHandle<'_>, raw_window_handle::HandleError> {
-        let raw = raw_window_handle::XlibWindowHandle::new(self.window);
-        // SAFETY: the embedder keeps the window alive while the engine lives (Context::xlib's contract).
-        Ok(unsafe { raw_window_handle::WindowHandle::borrow_raw(raw.into()) })
+// SAFETY: only handles the engine hands to Vulkan, whose surface functions may be called from
+// any thread (the window system's libraries synchronise their own use of the connection).
+unsafe impl Send for NativeWindow {}
+unsafe impl Sync for NativeWindow {}
+
+impl HasDisplayHandle for NativeWindow {
+    fn display_handle(&self) -> std::result::Result<DisplayHandle<'_>, HandleError> {
+        let raw: RawDisplayHandle = match *self {
+            NativeWindow::Xlib { display, .. } => XlibDisplayHandle::new(Some(display), 0).into(),
+            NativeWindow::Xcb { connection, .. } => XcbDisplayHandle::new(Some(connection), 0).into(),
+            NativeWindow::Wayland { display, .. } => WaylandDisplayHandle::new(display).into(),
+            NativeWindow::Win32 { .. } => WindowsDisplayHandle::new().into(),
+        };
+        // SAFETY: the embedder keeps the display open while the engine lives (Context::native's
+        // contract).
+        Ok(unsafe { DisplayHandle::borrow_raw(raw) })
+    }
+}
+
+impl HasWindowHandle for NativeWindow {
+    fn window_handle(&self) -> std::result::Result<WindowHandle<'_>, HandleError> {
+        let raw: RawWindowHandle = match *self {
+            NativeWindow::Xlib { window, .. } => XlibWindowHandle::new(window).into(),
+            NativeWindow::Xcb { window, .. } => XcbWindowHandle::new(window).into(),
+            NativeWindow::Wayland { surface, .. } => WaylandWindowHandle::new(surface).into(),
+            NativeWindow::Win32 { hinstance, hwnd } => {
+                let mut handle = Win32WindowHandle::new(hwnd);
+                handle.hinstance = hinstance;
+                handle.into()
+            }
+        };
+        // SAFETY: the embedder keeps the window alive while the engine lives (Context::native's
+        // contract).
+        Ok(unsafe { WindowHandle::borrow_raw(raw) })
     }
 }

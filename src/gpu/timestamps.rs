@@ -51,6 +51,11 @@ impl PassTimer {
         self.recorded = true;
     }
 
+    /// The frame [`PassTimer::submitted`] said was submitted never will be: nothing to collect.
+    pub fn discarded(&mut self) {
+        self.recorded = false;
+    }
+
     /// Opens pass `name`: a timestamp and a debug label of the same name.
     pub fn begin(&mut self, ctx: &Context, cmd: vk::CommandBuffer, name: &'static str) {
         assert!(!self.open, "pass {name} opened inside another");

@@ -4,8 +4,8 @@
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
-use super::Context;
 use super::barrier::{Access, transition};
+use super::context::{Context, UploadMark};
 use super::memory::Buffer;
 use super::target::Target;
 use crate::error::Result;
@@ -25,12 +25,13 @@ pub fn upload(
     Ok(dst)
 }
 
-/// Data uploaded by recording into frames ([`upload`]), by key. A frame that fails before it is
-/// recorded never runs its copies: what it uploaded is retired at the next frame, and made again
-/// when asked for.
+/// Data uploaded by recording into frames ([`upload`]), by key. A frame lost before it ran (an
+/// error while recording, or an embedder's discarded frame) never ran its copies: what it
+/// uploaded is made again when next asked for ([`Context::upload_kept`]), and the old copy
+/// retired (an embedder may have submitted a failed frame's command buffer all the same).
 pub struct Uploads<K, T> {
-    /// Key, the frames recorded when it was uploaded, and the data.
-    items: Vec<(K, u64, T)>,
+    /// Key, when it was uploaded, and the data.
+    items: Vec<(K, UploadMark, T)>,
     destroy: fn(T, &Context),
 }
 
@@ -39,29 +40,28 @@ impl<K: PartialEq, T: 'static> Uploads<K, T> {
         Uploads { items: Vec::new(), destroy }
     }
 
-    /// Once a frame, before its uploads: forgets what a frame that was never recorded uploaded.
-    pub fn begin_frame(&mut self, ctx: &Context) {
-        let recorded = ctx.frames_recorded();
-        let destroy = self.destroy;
-        let (lost, kept): (Vec<_>, Vec<_>) =
-            std::mem::take(&mut self.items).into_iter().partition(|(_, at, _)| *at == recorded);
-        self.items = kept;
-        // An embedder may have submitted the failed frame's command buffer all the same.
-        lost.into_iter().for_each(|(_, _, data)| ctx.retire(move |ctx| destroy(data, ctx)));
-    }
-
     /// The index of `key`'s data, made by `make` (recording its upload into this frame) when
-    /// absent.
+    /// absent or lost. Indices stay valid while the `Uploads` lives.
     pub fn index(&mut self, ctx: &Context, key: K, make: impl FnOnce() -> Result<T>) -> Result<usize> {
-        if let Some(at) = self.items.iter().position(|(k, _, _)| *k == key) {
-            return Ok(at);
+        let Some(at) = self.items.iter().position(|(k, _, _)| *k == key) else {
+            self.items.push((key, ctx.upload_mark(), make()?));
+            return Ok(self.items.len() - 1);
+        };
+        if !ctx.upload_kept(self.items[at].1) {
+            let old = std::mem::replace(&mut self.items[at].2, make()?);
+            self.items[at].1 = ctx.upload_mark();
+            let destroy = self.destroy;
+            ctx.retire(move |ctx| destroy(old, ctx));
         }
-        self.items.push((key, ctx.frames_recorded(), make()?));
-        Ok(self.items.len() - 1)
+        Ok(at)
     }
 
     pub fn get(&self, index: usize) -> &T {
         &self.items[index].2
+    }
+
+    pub fn get_mut(&mut self, index: usize) -> &mut T {
+        &mut self.items[index].2
     }
 
     pub fn destroy(self, ctx: &Context) {
@@ -144,4 +144,49 @@ pub fn copy_to_buffer(
     regions: &[vk::BufferImageCopy],
 ) {
     unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, target.image, target.last.layout, dst.buffer, regions) };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::{ContextOptions, FrameRing, Semaphores};
+
+    /// Data a frame uploads is kept while frames are submitted (and within its own frame), and
+    /// made again once a frame is lost: begun and never submitted, as on an error, or recorded
+    /// into an embedder's command buffer and discarded.
+    #[test]
+    fn what_a_lost_frame_uploaded_is_made_again() {
+        let mut ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
+        let mut ring = FrameRing::new(&ctx).unwrap();
+        let mut uploads: Uploads<u32, Buffer> = Uploads::new(Buffer::destroy);
+        let mut made = 0;
+        // A frame uploading `keys` into the ring's command buffer, submitted or lost.
+        let mut frame = |ctx: &Context, ring: &mut FrameRing, keys: &[u32], submit: bool| {
+            let (slot, cmd) = ring.begin(ctx).map(|(f, _)| (f.slot, f.cmd)).unwrap();
+            for &key in keys {
+                let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+                uploads
+                    .index(ctx, key, || {
+                        made += 1;
+                        upload(ctx, cmd, "uploaded", &[1, 2, 3, 4], usage)
+                    })
+                    .unwrap();
+            }
+            if submit {
+                ring.submit(ctx, slot, &Semaphores::NONE).unwrap();
+            }
+            made
+        };
+        assert_eq!(frame(&ctx, &mut ring, &[1, 1], true), 1, "made twice in its own frame");
+        assert_eq!(frame(&ctx, &mut ring, &[1], true), 1, "made again after a submitted frame");
+        assert_eq!(frame(&ctx, &mut ring, &[2], false), 2);
+        // Frame 3 was lost: its upload is made again, and, no earlier upload being trusted, 1's.
+        assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "not made again after a lost frame");
+        assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "made again after frames were submitted");
+        ring.drain(&ctx).unwrap();
+        uploads.destroy(&ctx);
+        ring.destroy(&ctx);
+        ctx.destroy();
+        assert!(ctx.validation_errors().is_empty(), "{:?}", ctx.validation_errors());
+    }
 }

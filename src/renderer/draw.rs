@@ -42,6 +42,8 @@ pub struct MeshCache {
     /// Meshes uploaded by the frame being recorded, until it is submitted (or handed back to
     /// the embedder): a frame abandoned on an error never ran their copies.
     uncommitted: Vec<MeshId>,
+    /// Those the frame committed last uploaded, in case the embedder discards it.
+    committed: Vec<MeshId>,
 }
 
 impl MeshCache {
@@ -99,7 +101,12 @@ impl MeshCache {
 
     /// The frame that uploaded the uncommitted meshes was submitted.
     pub fn commit(&mut self) {
-        self.uncommitted.clear();
+        self.committed = std::mem::take(&mut self.uncommitted);
+    }
+
+    /// The frame committed last was discarded unsubmitted: its uploads are uncommitted again.
+    pub fn uncommit(&mut self) {
+        self.uncommitted = std::mem::take(&mut self.committed);
     }
 
     /// Forgets meshes uploaded by a frame that was abandoned (its copies never ran); their

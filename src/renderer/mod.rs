@@ -533,7 +533,8 @@ impl Engine {
     ///
     /// The embedder keeps at most [`FRAMES_IN_FLIGHT`] recorded frames unfinished: before
     /// recording frame n it has waited for frame n − 2 to finish (an error says so otherwise),
-    /// and it submits every frame it records. Pass times arrive in [`Engine::take_timings`] as
+    /// and it submits every frame it records, or, before recording another, says it never will
+    /// with [`Engine::discard_recorded`]. Pass times arrive in [`Engine::take_timings`] as
     /// soon as a later `record` finds them written: one frame late when the GPU keeps up. A
     /// change of size or technique since the last frame never waits: what it replaces is
     /// destroyed [`FRAMES_IN_FLIGHT`] frames later ([`Context::retire`]), or when the engine is
@@ -604,6 +605,16 @@ impl Engine {
         self.push_timings(earlier);
         self.cpu_spans.push_back(clock.spans);
         Ok(recorded)
+    }
+
+    /// Forgets the frame the last [`Engine::record`] recorded, which the embedder will never
+    /// submit (it resets or frees the command buffer instead): the frame never happened, so
+    /// the next `record` uploads again what it uploaded and reuses its slot. Only right after
+    /// that `record`, before any other frame: an error otherwise.
+    pub fn discard_recorded(&mut self) -> Result<()> {
+        self.frames.as_mut().expect("engine is built").discard_external(&self.ctx)?;
+        self.data.discard_last();
+        Ok(())
     }
 
     fn ensure_targets(&mut self, w: u32, h: u32) -> Result<()> {

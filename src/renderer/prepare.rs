@@ -40,6 +40,13 @@ pub(super) struct Prepared {
 }
 
 impl FrameData {
+    /// The frame prepared last was discarded unsubmitted: it is prepared again, uploads and
+    /// all, by the next frame.
+    pub fn discard_last(&mut self) {
+        self.number -= 1;
+        self.meshes.uncommit();
+    }
+
     /// Prepares `frame` (its slot's previous frame has finished; new meshes are uploaded in its
     /// command buffer) at `extent`, seen by `camera`, or by the scene's camera fitted to the
     /// scene when `None`.

@@ -17,7 +17,7 @@ use winit::window::{Window, WindowAttributes, WindowId};
 use super::passes::Composite;
 use super::{Capture, Engine, FrameSettings};
 use crate::error::{Error, Result};
-use crate::gpu::{Acquired, Context, ContextOptions, Swapchain, Target};
+use crate::gpu::{Acquired, Context, ContextOptions, NativeWindow, Swapchain, Target};
 use crate::scene::Scene;
 use crate::technique::Params;
 
@@ -241,20 +241,15 @@ impl Engine {
         Ok(engine)
     }
 
-    /// An engine presenting to the embedder's Xlib `window` on `display` (the C ABI's
-    /// `softshadow_engine_create_xlib`), at the window's size, which it reads from the surface
+    /// An engine presenting to the embedder's native `window` (the C ABI's
+    /// `softshadow_engine_create_window`), at the window's size, which it reads from the surface
     /// each frame.
     ///
     /// # Safety
-    /// `display` is an open Xlib `Display*` and `window` a window on it; both outlive the engine.
-    pub unsafe fn from_xlib(
-        options: &ContextOptions,
-        display: *mut std::ffi::c_void,
-        window: std::ffi::c_ulong,
-        request: WindowOptions,
-    ) -> Result<Self> {
+    /// As [`Context::native`]: the handles are valid and outlive the engine.
+    pub unsafe fn from_native(options: &ContextOptions, window: NativeWindow, request: WindowOptions) -> Result<Self> {
         // SAFETY: the caller's contract, passed on.
-        let mut engine = Engine::on(unsafe { Context::xlib(options, display, window) }?)?;
+        let mut engine = Engine::on(unsafe { Context::native(options, window) }?)?;
         engine.window = Some(Presenter::new(Size::Surface, request));
         Ok(engine)
     }

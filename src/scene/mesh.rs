@@ -9,6 +9,7 @@ use glam::Vec3;
 
 use super::read::{MAX_OBJ_BYTES, MAX_OBJ_LINE, overlong_line, read_limited};
 use crate::error::{Error, Result};
+use crate::geometry::silhouette::FacePlanes;
 use crate::geometry::{Aabb, EdgeAdjacency};
 
 /// Identifies a mesh for the GPU cache; unique for the life of the process.
@@ -41,6 +42,8 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Built once here; silhouettes walk it every frame.
     pub adjacency: EdgeAdjacency,
+    /// Built once here; silhouettes test the light against them every frame.
+    pub planes: FacePlanes,
     pub bounds: Aabb,
     /// Simplified copies made by [`Mesh::shadow_mesh`], by their error's power of two.
     shadow_meshes: Mutex<Vec<(i32, Arc<Mesh>)>>,
@@ -81,9 +84,10 @@ impl Mesh {
         }
         let bounds = Aabb::from_points(positions.iter().copied());
         let adjacency = EdgeAdjacency::build(&triangles);
+        let planes = FacePlanes::new(&positions, &triangles);
         static NEXT: AtomicU64 = AtomicU64::new(0);
         let id = MeshId(NEXT.fetch_add(1, Ordering::Relaxed));
-        Ok(Mesh { id, name, positions, triangles, adjacency, bounds, shadow_meshes: Mutex::default() })
+        Ok(Mesh { id, name, positions, triangles, adjacency, planes, bounds, shadow_meshes: Mutex::default() })
     }
 
     /// Loads every object of an OBJ file into one mesh (triangulated), within the limits of

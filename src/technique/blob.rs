@@ -102,7 +102,7 @@ impl Technique for Blobs {
         }
         let ctx = frame.ctx;
         let params = Vec4::new(blobs.len() as f32, params.get(&SOFTNESS) as f32, 0.0, 0.0);
-        let view = ground::view(&plane, plane.height(light), Vec4::ZERO, params);
+        let view = ground::view(&plane, Vec4::ZERO, params);
         self.view.write(frame.slot, bytes_of(&view));
         let bytes: &[u8] = cast_slice(&blobs);
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;

@@ -162,7 +162,7 @@ impl Technique for Concentric {
         let Some(window) = window else {
             return clear_visibility(frame, visibility);
         };
-        let view = ground::view(&plane, hl, window, Vec4::ZERO);
+        let view = ground::view(&plane, window, Vec4::ZERO);
         self.view.write(frame.slot, bytes_of(&view));
 
         // Per projection: (its depth, its weight), then a matrix per draw, indexed by instance.

@@ -10,7 +10,7 @@ use gpu_allocator::MemoryLocation;
 
 use super::knobs::Knob;
 use crate::error::Result;
-use crate::gpu::{Buffer, Context, Target, TargetDesc, copy_to_target};
+use crate::gpu::{Buffer, Context, Target, TargetDesc, Uploads, copy_to_target};
 
 /// The knob choosing the curve. Linear is the default: it measured best against the reference
 /// for both plateaus and smoothies (the outer-only penumbrae start at the hard edge, where the
@@ -49,18 +49,27 @@ pub fn disk_edge(t: f64) -> f64 {
     1.0 - (u.acos() - u * (1.0 - u * u).sqrt()) / std::f64::consts::PI
 }
 
-/// The texture, uploaded on the first frame that needs it.
-#[derive(Default)]
+/// The texture, uploaded on the first frame that needs it (again after a lost frame: that
+/// frame's copy never ran), with the staging buffer its copy reads.
 pub struct Falloff {
-    texture: Option<Target>,
-    /// Read by the upload recorded in the first frame; kept until the technique goes.
-    staging: Option<Buffer>,
+    uploaded: Uploads<(), (Target, Buffer)>,
+}
+
+impl Default for Falloff {
+    fn default() -> Self {
+        Falloff {
+            uploaded: Uploads::new(|(texture, staging), ctx| {
+                texture.destroy(ctx);
+                staging.destroy(ctx);
+            }),
+        }
+    }
 }
 
 impl Falloff {
-    /// The texture, recording its one-time upload into `cmd` on first use.
+    /// The texture, recording its upload into `cmd` on first use.
     pub fn texture(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<&mut Target> {
-        if self.texture.is_none() {
+        let at = self.uploaded.index(ctx, (), || {
             let texels: Vec<u16> = CURVES
                 .iter()
                 .flat_map(|f| (0..SIZE).map(|i| (f(i as f64 / (SIZE - 1) as f64) * 65535.0).round() as u16))
@@ -80,15 +89,13 @@ impl Falloff {
             };
             let range = vk::DescriptorBufferInfo { buffer: staging.buffer, offset: 0, range: bytes.len() as u64 };
             copy_to_target(ctx, cmd, range, &mut texture);
-            self.staging = Some(staging);
-            self.texture = Some(texture);
-        }
-        Ok(self.texture.as_mut().expect("made above"))
+            Ok((texture, staging))
+        })?;
+        Ok(&mut self.uploaded.get_mut(at).0)
     }
 
     pub fn destroy(self, ctx: &Context) {
-        self.texture.into_iter().for_each(|t| t.destroy(ctx));
-        self.staging.into_iter().for_each(|b| b.destroy(ctx));
+        self.uploaded.destroy(ctx);
     }
 }
 

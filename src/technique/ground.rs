@@ -7,11 +7,10 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::ClassicView;
 use crate::geometry::plateau::ReceiverPlane;
 
-/// The plane's frame for the resolves; a surface within 1e-3 of the light's height of the
-/// plane is on it (as the plateau's resolve takes it).
-pub(crate) fn view(plane: &ReceiverPlane, light_height: f32, window: Vec4, params: Vec4) -> ClassicView {
+/// The plane's frame for the resolves (which surfaces are on it: `on_plane`, glsl/common/camera.glsl).
+pub(crate) fn view(plane: &ReceiverPlane, window: Vec4, params: Vec4) -> ClassicView {
     ClassicView {
-        plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
+        plane_origin: plane.origin.extend(0.0),
         plane_normal: plane.normal.extend(0.0),
         plane_u: plane.u.extend(0.0),
         plane_v: plane.v.extend(0.0),

@@ -339,10 +339,9 @@ impl Technique for Plateau {
             Vec4::ZERO,
             Vec4::new(-1.0 - window.x * scale.x, -1.0 - window.y * scale.y, 0.0, 1.0),
         );
-        let light_height = plane.height(light.position);
         let view = PlateauView {
             umbra: to_clip * plane.shadow_matrix(light.position),
-            plane_origin: plane.origin.extend(1e-3 * light_height.abs()),
+            plane_origin: plane.origin.extend(0.0),
             plane_normal: plane.normal.extend(0.0),
             plane_u: plane.u.extend(0.0),
             plane_v: plane.v.extend(0.0),

@@ -61,7 +61,11 @@ const SAMPLES: Knob = Knob {
     integer: true,
     help: "points on the light, one shadow map each",
 };
-const MAP_SIZE: Knob = Knob { default: 1024.0, max: 4096.0, ..SHADOW_MAP_SIZE };
+/// 2048 by default: each sample's hard edge moves by about a texel of its biases, which from a
+/// light close to its caster (a frustum as wide as the cube seen from 0.6 of its side) put
+/// 1024² maps 0.0125 RMSE off the ray tracer in the penumbrae, over the truths' 0.01 (issue 19);
+/// 2048²: 0.006, 4096²: 0.003.
+const MAP_SIZE: Knob = Knob { default: 2048.0, max: 4096.0, ..SHADOW_MAP_SIZE };
 
 /// Tiles per atlas side at most: 16 shadow maps per accumulation pass.
 const MAX_TILES: u32 = 4;

@@ -106,8 +106,6 @@ impl GpuVolumes {
         let ctx = frame.ctx;
         self.dispatches.clear();
         self.groups = groups.len();
-        // A frame that was never recorded ran none of its uploads.
-        self.meshes.begin_frame(ctx);
         for (g, group) in groups.iter().enumerate() {
             for &(object, two_sided) in group {
                 let mesh = &frame.scene.objects[object].mesh;

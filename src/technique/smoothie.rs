@@ -48,10 +48,8 @@ use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::Aabb;
-use crate::geometry::silhouette::{Caster, Mailbox};
-use crate::geometry::smoothie::{
-    Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, silhouette, smoothies,
-};
+use crate::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
+use crate::geometry::smoothie::{Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, Fullscreen, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
     Target, TargetDesc, Variants, VertexInput, draw_indirect, draw_vertices, ensure, shaders, transition,
@@ -161,10 +159,9 @@ struct SilhouetteKey {
     light: Vec3,
 }
 
+/// A caster's silhouette edges (object-space vertex numbers) and what they were found from.
 struct CasterSilhouette {
     key: SilhouetteKey,
-    positions: Vec<Vec3>,
-    bounds: Aabb,
     edges: Vec<([u32; 2], u32)>,
 }
 
@@ -180,8 +177,6 @@ pub struct Smoothie {
     buffer: Option<Target>,
     falloff: Falloff,
     silhouettes: Vec<Option<CasterSilhouette>>,
-    mailbox: Mailbox,
-    frame: u64,
     /// The compute path, made when first asked for.
     gpu: Option<GpuSilhouettes>,
 }
@@ -199,8 +194,6 @@ impl Smoothie {
             buffer: None,
             falloff: Falloff::default(),
             silhouettes: Vec::new(),
-            mailbox: Mailbox::default(),
-            frame: 0,
             gpu: None,
         })
     }
@@ -227,20 +220,20 @@ impl Smoothie {
             let o = &shadow_caster(o, light, params);
             let model = o.transform.matrix();
             let key = SilhouetteKey { mesh: o.mesh.id(), model, light };
+            // In object space: the face planes built with the mesh against the light taken
+            // there, then the silhouette's own vertices through view · model, so a moved caster
+            // costs no transform of its whole mesh.
+            let caster =
+                Caster { positions: &o.mesh.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
             if cached.as_ref().is_none_or(|c| c.key != key) {
-                let positions: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
-                let caster =
-                    Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-                let edges = silhouette(&caster, light);
-                let bounds = Aabb::from_points(positions.iter().copied());
-                *cached = Some(CasterSilhouette { key, positions, bounds, edges });
+                let facing = o.mesh.planes.light_facing(&model, light);
+                let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
+                *cached = Some(CasterSilhouette { key, edges });
             }
             let c = cached.as_ref().expect("set above");
-            let caster = Caster { positions: &c.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            let penumbra = penumbra(centred, view, &c.bounds);
-            // Vertex numbers are per mesh: a fresh stamp per caster keeps the mailboxes apart.
-            self.frame += 1;
-            out.extend(&smoothies(view, &caster, &c.edges, (size, far), penumbra, &mut self.mailbox, self.frame));
+            let view = *view * model;
+            let penumbra = penumbra(centred, &view, &o.mesh.bounds);
+            out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra));
         }
         out
     }

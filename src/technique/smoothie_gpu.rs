@@ -1,8 +1,9 @@
 //! The smoothie's silhouettes on the GPU (`gpu_silhouettes = 1`), beyond the paper, whose
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
-//! invocation per edge finds silhouettes and appends smoothie edges and corners
-//! (`glsl/smoothie/silhouettes.comp`); the smoothie pass draws them with an indirect draw.
-//! Each mesh's positions, triangles, edges and mailbox stamps are uploaded once. The output
+//! invocation per edge finds silhouettes and pairs the edge ends at each silhouette vertex, then
+//! one more appends smoothie edges and corners (`glsl/smoothie/silhouettes.comp`); the smoothie
+//! pass draws them with an indirect draw. Each mesh's positions, triangles, edges and per-vertex
+//! stamped slots are uploaded once. The output
 //! (one copy, not one per frame in flight) is only recomputed when a caster, the light view or
 //! the smoothie size changed: a static scene records no silhouette work after its first frame.
 
@@ -16,8 +17,8 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::smoothie::{Penumbra, SmoothieSize};
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, Uploads, Variants, buffer_barrier,
-    dispatch, shaders, update_buffer, upload,
+    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
+    buffer_barrier, dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId};
 
@@ -43,7 +44,8 @@ impl MeshBuffers {
         let triangles: Vec<[u32; 4]> = mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
         let edges: Vec<[u32; 4]> =
             mesh.adjacency.edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]).collect();
-        let stamps = vec![0u32; mesh.positions.len()];
+        // Per vertex: its stamped edge-end count and its first two edge ends (silhouettes.comp).
+        let stamps = vec![0u32; 3 * mesh.positions.len()];
         let mut made: Vec<Buffer> = Vec::new();
         for (name, bytes) in [
             ("silhouette positions", cast_slice::<Vec4, u8>(&positions)),
@@ -72,16 +74,17 @@ impl MeshBuffers {
 
 /// The compute path's pipeline and buffers.
 pub struct GpuSilhouettes {
-    /// The silhouette pipeline, by whether the smoothie size is physical.
-    pipelines: Variants<bool>,
+    /// The silhouette pipelines, by whether the smoothie size is physical and the dispatch
+    /// pairs edge ends (or draws).
+    pipelines: Variants<(bool, bool)>,
     meshes: Uploads<MeshId, MeshBuffers>,
     params: Option<PerFrame>,
     vertices: Option<PerFrame>,
     args: PerFrame,
     stamp: u32,
-    /// What the output was last computed from, and the frames recorded before the frame that
-    /// computed it; `None` when it must be computed.
-    computed: Option<(OutputKey, u64)>,
+    /// What the output was last computed from, and when ([`Context::upload_kept`] says whether
+    /// that frame ran); `None` when it must be computed.
+    computed: Option<(OutputKey, UploadMark)>,
 }
 
 /// Everything the silhouette output depends on.
@@ -121,21 +124,17 @@ impl GpuSilhouettes {
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
-        // A frame that was never recorded ran neither its uploads nor its dispatches.
-        self.meshes.begin_frame(ctx);
-        if self.computed.as_ref().is_some_and(|(_, at)| *at == ctx.frames_recorded()) {
-            self.computed = None;
-        }
         let cmd = frame.cmd;
         let meshes = casters
             .iter()
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
-        // Six vertices per edge (twice, with the inner quads) and per corner.
+        // Six vertices per quad: one per edge (two with the inner quads), at most three per
+        // corner.
         let quads_per_edge = 1 + centred as usize;
         let capacity: u64 = casters
             .iter()
-            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + o.mesh.positions.len()) as u64)
+            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + 3 * o.mesh.positions.len()) as u64)
             .sum();
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         PerFrame::ensure(
@@ -168,22 +167,15 @@ impl GpuSilhouettes {
             centred,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
-        if self.computed.as_ref().is_some_and(|(k, _)| *k == key) {
+        // A lost frame ran neither its uploads nor its dispatches.
+        if self.computed.as_ref().is_some_and(|(k, at)| *k == key && ctx.upload_kept(*at)) {
             return Ok((vertices, args));
         }
-        let pipeline = self.pipelines.get(physical, |&physical| {
-            Pipeline::compute(
-                ctx,
-                "silhouettes",
-                &shaders::SMOOTHIE_SILHOUETTES_COMP,
-                &[("PHYSICAL_SIZE", physical as u32)],
-            )
-        })?;
         let mut params = Vec::with_capacity(casters.len());
         for o in &casters {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             let model = o.transform.matrix();
-            let (near, caster_far) = match penumbra(centred, view, &o.mesh.bounds.transformed(&model)) {
+            let (near, caster_far) = match penumbra(centred, &(*view * model), &o.mesh.bounds) {
                 Penumbra::Centred { near, far } => (near, far),
                 Penumbra::Outer => (0.0, 0.0),
             };
@@ -214,24 +206,33 @@ impl GpuSilhouettes {
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
                 range: PARAMS_BYTES,
             };
-            pipeline.bind(
-                ctx,
-                cmd,
-                &[
-                    Descriptor::Buffer(one),
-                    Descriptor::Buffer(mesh.positions.range()),
-                    Descriptor::Buffer(mesh.triangles.range()),
-                    Descriptor::Buffer(mesh.edges.range()),
-                    Descriptor::Buffer(mesh.stamps.range()),
-                    Descriptor::Buffer(args),
-                    Descriptor::Buffer(vertices),
-                ],
-            )?;
-            dispatch(ctx, cmd, mesh.edge_count.div_ceil(GROUP));
+            // Pairing the silhouette vertices' edge ends, then drawing: the second dispatch reads
+            // what the first wrote.
+            for pairing in [true, false] {
+                let pipeline = self.pipelines.get((physical, pairing), |&(physical, pairing)| {
+                    let constants = [("PHYSICAL_SIZE", physical as u32), ("PAIRING", pairing as u32)];
+                    Pipeline::compute(ctx, "silhouettes", &shaders::SMOOTHIE_SILHOUETTES_COMP, &constants)
+                })?;
+                pipeline.bind(
+                    ctx,
+                    cmd,
+                    &[
+                        Descriptor::Buffer(one),
+                        Descriptor::Buffer(mesh.positions.range()),
+                        Descriptor::Buffer(mesh.triangles.range()),
+                        Descriptor::Buffer(mesh.edges.range()),
+                        Descriptor::Buffer(mesh.stamps.range()),
+                        Descriptor::Buffer(args),
+                        Descriptor::Buffer(vertices),
+                    ],
+                )?;
+                dispatch(ctx, cmd, mesh.edge_count.div_ceil(GROUP));
+                buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::COMPUTE_READ_WRITE);
+            }
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
         frame.timer.end(ctx, cmd);
-        self.computed = Some((key, ctx.frames_recorded()));
+        self.computed = Some((key, ctx.upload_mark()));
         Ok((vertices, args))
     }
 
