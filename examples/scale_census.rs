@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides};
-use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Scene;
