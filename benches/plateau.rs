@@ -8,7 +8,7 @@ use std::path::Path;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::plateau::{Penumbra, PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
-use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 use softshadow::scene::Mesh;
 
 fn plateau(c: &mut Criterion) {
@@ -23,6 +23,7 @@ fn plateau(c: &mut Criterion) {
         size: PenumbraSize::Physical { scale: 1.0 },
         penumbra: Penumbra::Centred,
         cone_segments: 32,
+        wedges: true,
     };
     c.bench_function("plateau silhouettes, wingnut", |b| {
         b.iter(|| {
@@ -30,13 +31,8 @@ fn plateau(c: &mut Criterion) {
             penumbra_edges(&caster, &facing, EdgeSource::Silhouettes)
         })
     });
-    let mut mailbox = Mailbox::default();
-    let mut frame = 0;
     c.bench_function("plateau sides (silhouettes, cones, sheets), wingnut", |b| {
-        b.iter(|| {
-            frame += 1;
-            plateau_sides(&plane, &light, black_box(&caster), 1.0, EdgeSource::Silhouettes, &mut mailbox, frame)
-        })
+        b.iter(|| plateau_sides(&plane, &light, black_box(&caster), 1.0, EdgeSource::Silhouettes))
     });
 }
 

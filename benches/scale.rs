@@ -10,7 +10,7 @@ use std::path::Path;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, ReceiverPlane, plateau_sides};
-use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
@@ -46,16 +46,15 @@ fn scale(c: &mut Criterion) {
         size: PenumbraSize::Physical { scale: 1.0 },
         penumbra: plateau::Penumbra::Centred,
         cone_segments: 32,
+        wedges: true,
     };
-    let (mut mailbox, mut frame) = (Mailbox::default(), 0);
     let mut step = 0.0f32;
     group.bench_function("plateau CPU geometry, moving frame", |b| {
         b.iter(|| {
             step += 1e-3;
-            frame += 1;
             let positions = world(&(Mat4::from_translation(Vec3::X * step) * model));
             let caster = Caster { positions: &positions, triangles: &koala.triangles, adjacency: &koala.adjacency };
-            plateau_sides(&plane, &plateau_light, &caster, 0.0, EdgeSource::Silhouettes, &mut mailbox, frame)
+            plateau_sides(&plane, &plateau_light, &caster, 0.0, EdgeSource::Silhouettes)
         })
     });
     let bounds = Aabb::from_points(positions.iter().copied());

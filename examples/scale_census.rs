@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides};
-use softshadow::geometry::silhouette::{Caster, EdgeSource, Mailbox, light_facing, penumbra_edges};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Scene;
@@ -40,6 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         size: PenumbraSize::Physical { scale: 1.0 },
         penumbra: plateau::Penumbra::Centred,
         cone_segments: CONE_SEGMENTS,
+        wedges: true,
     };
     let h = ground.half_size;
     let receivers = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, z)| Vec3::new(x, ground.height, z));
@@ -62,7 +63,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let closed_edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
 
         let started = Instant::now();
-        let sides = plateau_sides(&plane, &plateau_light, &caster, 0.0, source, &mut Mailbox::default(), 1);
+        let sides = plateau_sides(&plane, &plateau_light, &caster, 0.0, source);
         let sides_ms = started.elapsed().as_secs_f64() * 1e3;
         let (lo, hi) = sides.footprint.unwrap_or((Vec2::ZERO, Vec2::ONE));
         let plateau_texel = (texels * texels) / f64::from((hi - lo).x * (hi - lo).y).max(1e-12);
@@ -73,15 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if source != EdgeSource::Silhouettes {
             // What the open mesh would cost if only the edges bounding its lit part had sides.
             let started = Instant::now();
-            let bounding = plateau_sides(
-                &plane,
-                &plateau_light,
-                &caster,
-                0.0,
-                EdgeSource::Silhouettes,
-                &mut Mailbox::default(),
-                1,
-            );
+            let bounding = plateau_sides(&plane, &plateau_light, &caster, 0.0, EdgeSource::Silhouettes);
             let ms = started.elapsed().as_secs_f64() * 1e3;
             let fragments =
                 (area(bounding.cones.iter().map(uv)) + area(bounding.sheets.iter().map(uv))) * plateau_texel;

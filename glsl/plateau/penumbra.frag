@@ -12,6 +12,9 @@
 // to channel g instead, if its edge bounds that caster's own shadow: each blocks part of the
 // light, and the resolve multiplies the two (Chan & Durand Fig. 10's overlapping penumbrae).
 layout(constant_id = 0) const bool CENTRED = false;
+// More than one caster: the mask may hold another caster's number where a side is drawn. With
+// one, it holds only this caster's or none, and the texel under the fragment need not be read.
+layout(constant_id = 1) const bool OVERLAPS = true;
 
 layout(set = 0, binding = 1) uniform sampler2D mask;
 
@@ -45,14 +48,15 @@ void main() {
         discard; // on the apex itself: the sheets meeting there write it
     }
     vec2 probe = PROBE * normalize(across);
-    uint here = caster_at(gl_FragCoord.xy);
-    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
+    uint here = OVERLAPS ? caster_at(gl_FragCoord.xy) : 0u;
     if (here == 0u || here == in_caster) {
-        if (a != 0u && b != 0u) {
+        // Outward first: on the hard shadow's boundary it is lit, and one read decides.
+        if (caster_at(foot + probe) != 0u && caster_at(foot - probe) != 0u) {
             discard;
         }
         return;
     }
+    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
     // Over another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
     // something other than its own caster across it.
     bool outer_half = in_normal != vec2(0.0) && dot(from_foot, in_normal * size) > 0.0;

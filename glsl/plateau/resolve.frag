@@ -81,7 +81,9 @@ void main() {
         return;
     }
     vec2 signed_t = plateau_s(tc);
-    out_visibility = CENTRED
-        ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.x) * falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.y)
-        : falloff_at(falloff, FALLOFF, signed_t.x);
+    // Other casters' outer penumbrae reach few pixels: elsewhere g is 1, and so is its factor
+    // (every curve ends at 1), which is not read.
+    float others = CENTRED && signed_t.y < 1.0 ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.y) : 1.0;
+    out_visibility = CENTRED ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.x) * others
+                             : falloff_at(falloff, FALLOFF, signed_t.x);
 }

@@ -30,6 +30,15 @@
 //! shadows overlap, the lowest caster's number, so no inner penumbra lightens what another
 //! caster blocks.
 //!
+//! Cost (issue 18). A cone is drawn only where no sheet covers it, the wedge of a corner
+//! (`cones = 0`: Haines' whole cones, measured against): on fine meshes, whose edges are far
+//! shorter than the penumbra, whole cones drew each texel several times over (the koala's
+//! cones: 9.2M fragments at 1024², 1.7M as wedges). Open meshes get sides only along their
+//! shadow's outline, not along every light-facing polygon's edges (`edges = 1`), which mostly
+//! lay inside it and were probed away. The centred probes read the mask's outward side first,
+//! which decides alone on the hard shadow's boundary, and with a single caster skip the texel
+//! under the fragment.
+//!
 //! Casters reaching the light's height: the part at or above it casts nothing (no
 //! anti-shadows): its cones and sheets are skipped, and the umbra's homogeneous clip (w =
 //! light height − point height > 0) cuts it off, so the shadow of the rest runs to the horizon.
@@ -55,7 +64,7 @@ use crate::geometry::plateau::{
     PLATEAU_VERTEX_FLOATS, Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane,
     plateau_sides,
 };
-use crate::geometry::silhouette::{Caster, EdgeSource, Mailbox};
+use crate::geometry::silhouette::{Caster, EdgeSource};
 use crate::gpu::{
     Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
     Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_vertices, ensure, shaders,
@@ -74,11 +83,19 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         CENTRED,
         CURVE,
         EDGES,
+        CONES,
         OFF_PLANE,
         SHADOW_MESH_ERROR,
     ],
     create: |ctx, _, visibility| Ok(Box::new(Plateau::new(ctx, visibility)?)),
-    bench: &[&[], OUTER_ONLY, OUTER_ONLY_NARROW, &[("texture_size", "512")], &[("shadow_mesh_error", "1")]],
+    bench: &[
+        &[],
+        OUTER_ONLY,
+        OUTER_ONLY_NARROW,
+        WHOLE_CONES,
+        &[("texture_size", "512")],
+        &[("shadow_mesh_error", "1")],
+    ],
     sweep_knobs: SweepKnobs::DEFAULTS,
     // Issue 4: plateaus against the hard map at the same screen size.
     cost_goal: Some(CostGoal { setting: &[], baseline: &shadow_map::INFO, baseline_setting: &[], max_ratio: 1.3 }),
@@ -136,9 +153,20 @@ const EDGES: Knob = Knob {
     name: "edges",
     default: 0.0,
     min: 0.0,
-    max: 2.0,
+    max: 1.0,
     integer: true,
-    help: "0 auto (silhouettes; light-facing polygons for open meshes), 1 silhouettes, 2 polygons",
+    help: "0 the shadow's outline (silhouettes, and an open mesh's boundary edges), 1 every light-facing polygon (§3)",
+};
+/// Whole cones as Haines drew them (§2), against which the corner wedges are measured.
+pub const WHOLE_CONES: Setting = &[("cones", "0")];
+
+const CONES: Knob = Knob {
+    name: "cones",
+    default: 1.0,
+    min: 0.0,
+    max: 1.0,
+    integer: true,
+    help: "0 whole cones at silhouette vertices (§2), 1 only the corner wedges between the sheets",
 };
 const OFF_PLANE: Knob = Knob {
     name: "off_plane",
@@ -176,8 +204,8 @@ struct SidesKey {
 
 pub struct Plateau {
     umbra: Pipeline,
-    /// Side pipelines, outer only or centred.
-    penumbrae: Variants<bool>,
+    /// Side pipelines by centring and whether several casters' shadows may overlap.
+    penumbrae: Variants<(bool, bool)>,
     /// Resolve pipelines by falloff curve, off-plane mode and centring.
     resolves: Variants<(u32, bool, bool)>,
     /// The V target's format, which the resolves write.
@@ -190,8 +218,6 @@ pub struct Plateau {
     falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
     sides: Vec<Option<(SidesKey, PlateauGeometry)>>,
-    mailbox: Mailbox,
-    frame: u64,
 }
 
 impl Plateau {
@@ -220,8 +246,6 @@ impl Plateau {
             depth: None,
             falloff: Falloff::default(),
             sides: Vec::new(),
-            mailbox: Mailbox::default(),
-            frame: 0,
         })
     }
 
@@ -229,20 +253,14 @@ impl Plateau {
     fn build_sides(&mut self, frame: &FrameInputs<'_>, plane: &ReceiverPlane, light: PlateauLight, params: &Params) {
         let objects = &frame.scene.objects;
         self.sides.resize(objects.len(), None);
-        self.frame += 1;
         for (number, (o, cached)) in objects.iter().zip(&mut self.sides).enumerate() {
             if !o.casts {
                 *cached = None;
                 continue;
             }
             let o = &shadow_caster(o, light.position, params);
-            let source = match params.get(&EDGES) as u32 {
-                1 => EdgeSource::Silhouettes,
-                2 => EdgeSource::LightFacing,
-                // Open meshes have no closed silhouette: the connectivity-free mode of §3.
-                _ if o.mesh.adjacency.boundary + o.mesh.adjacency.non_manifold > 0 => EdgeSource::LightFacing,
-                _ => EdgeSource::Silhouettes,
-            };
+            // Open meshes too: their silhouettes with their boundary edges bound the shadow.
+            let source = if params.is_on(&EDGES) { EdgeSource::LightFacing } else { EdgeSource::Silhouettes };
             let model = o.transform.matrix();
             let key = SidesKey { mesh: o.mesh.id(), model, light, plane: *plane, source };
             if cached.as_ref().is_some_and(|(k, _)| *k == key) {
@@ -250,11 +268,9 @@ impl Plateau {
             }
             let positions: Vec<_> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
             let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            // Vertex numbers are per mesh: a fresh frame stamp per caster keeps mailboxes apart.
-            self.frame += 1;
             // The umbra mask's number: the draw's instance (the object's index) plus one.
             let number = (number + 1).min(u16::MAX as usize) as f32;
-            let sides = plateau_sides(plane, &light, &caster, number, source, &mut self.mailbox, self.frame);
+            let sides = plateau_sides(plane, &light, &caster, number, source);
             *cached = Some((key, sides));
         }
     }
@@ -303,6 +319,7 @@ impl Technique for Plateau {
             size,
             penumbra: if centred { Penumbra::Centred } else { Penumbra::Outer },
             cone_segments: CONE_SEGMENTS,
+            wedges: params.is_on(&CONES),
         };
         self.build_sides(frame, &plane, light, params);
         let mut geometry = PlateauGeometry::default();
@@ -359,8 +376,9 @@ impl Technique for Plateau {
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
-        let penumbra = self.penumbrae.get(centred, |&centred| {
-            let constants = [("CENTRED", centred as u32)];
+        let overlaps = self.sides.iter().flatten().count() > 1;
+        let penumbra = self.penumbrae.get((centred, overlaps), |&(centred, overlaps)| {
+            let constants = [("CENTRED", centred as u32), ("OVERLAPS", overlaps as u32)];
             let desc = PipelineDesc::new("penumbra", &shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG)
                 .vertex_input(VertexInput::Floats(&PLATEAU_VERTEX_FLOATS))
                 .colors(&[PLATEAU_FORMAT])
