@@ -135,24 +135,6 @@ pub fn penumbra_edges(caster: &Caster<'_>, facing: &Facing, source: EdgeSource) 
     }
 }
 
-/// Cones drawn this frame, by vertex: each silhouette vertex's cone is drawn once even when
-/// several edges share it (§3's mailbox).
-#[derive(Clone, Debug, Default)]
-pub struct Mailbox {
-    stamps: Vec<u64>,
-}
-
-impl Mailbox {
-    /// True the first time `vertex` is posted in `frame`.
-    pub fn first_visit(&mut self, vertex: u32, frame: u64) -> bool {
-        let i = vertex as usize;
-        if self.stamps.len() <= i {
-            self.stamps.resize(i + 1, u64::MAX);
-        }
-        std::mem::replace(&mut self.stamps[i], frame) != frame
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use glam::Quat;
