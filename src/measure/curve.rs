@@ -89,6 +89,16 @@ pub fn write_curve(points: &[CurvePoint], baseline: &str, dir: &Path) -> Result<
     plot(points, &dir.join("cost_curve.png"))
 }
 
+/// A triangle count as an axis label: 1k, 25k, 1M.
+fn count(n: f64) -> String {
+    let tenths = |x: f64| (x * 10.0).round() / 10.0;
+    match n {
+        n if n >= 1e6 => format!("{}M", tenths(n / 1e6)),
+        n if n >= 1e3 => format!("{}k", tenths(n / 1e3)),
+        n => format!("{n:.0}"),
+    }
+}
+
 /// GPU ms against triangles, both logarithmic, a line per technique labelled with its slope.
 fn plot(points: &[CurvePoint], path: &Path) -> Result<()> {
     register_sans(path)?;
@@ -109,6 +119,8 @@ fn plot(points: &[CurvePoint], path: &Path) -> Result<()> {
         .configure_mesh()
         .x_desc("caster triangles")
         .y_desc("GPU ms (median)")
+        .x_label_formatter(&|n| count(*n))
+        .y_label_formatter(&|ms| if *ms >= 10.0 { format!("{ms:.0}") } else { format!("{ms:.1}") })
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| plot_error(path, e))?;
@@ -145,6 +157,12 @@ mod tests {
 
     fn at(technique: &str, triangles: usize, gpu_ms: f64) -> CurvePoint {
         CurvePoint { technique: technique.into(), triangles, gpu_ms }
+    }
+
+    #[test]
+    fn triangle_counts_label_in_k_and_m() {
+        let labels: Vec<String> = [666.7, 1e3, 2.5e4, 1e5, 1e6, 1.5e6].map(count).into();
+        assert_eq!(labels, ["667", "1k", "25k", "100k", "1M", "1.5M"]);
     }
 
     #[test]
