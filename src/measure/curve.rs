@@ -7,7 +7,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::plot::{COLORS, plot_error, register_sans};
+use super::plot::{COLORS, legend_and_present, plot_error, register_sans};
 use crate::error::{Error, Result};
 
 /// One technique's median frame at one size.
@@ -140,15 +140,7 @@ fn plot(points: &[CurvePoint], path: &Path) -> Result<()> {
             .label(label)
             .legend(move |(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], color.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 13))
-        .draw()
-        .map_err(|e| plot_error(path, e))?;
-    root.present().map_err(|e| plot_error(path, e))
+    legend_and_present(&mut chart, &root, path, SeriesLabelPosition::UpperLeft, 13)
 }
 
 #[cfg(test)]

@@ -33,6 +33,25 @@ pub(super) fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
 
 /// Registers DejaVu Sans as plotters' "sans-serif", once per process (plotters keeps
 /// registered fonts for the process's life).
+/// Draws the series' legend at `position` and writes the image: the last step of every chart.
+pub(super) fn legend_and_present<'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    root: &DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>,
+    path: &Path,
+    position: SeriesLabelPosition,
+    font_size: u32,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font_size))
+        .draw()
+        .map_err(|e| plot_error(path, e))?;
+    root.present().map_err(|e| plot_error(path, e))
+}
+
 pub(super) fn register_sans(path: &Path) -> Result<()> {
     static REGISTERED: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
     let registered = REGISTERED.get_or_init(|| {
@@ -97,14 +116,7 @@ pub fn tradeoff(rows: &[BenchRow], path: &Path) -> Result<()> {
                 .legend(|(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], BLACK.stroke_width(2)));
         }
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(|e| plot_error(path, e))?;
-    root.present().map_err(|e| plot_error(path, e))
+    legend_and_present(&mut chart, &root, path, SeriesLabelPosition::UpperRight, 14)
 }
 
 /// A line chart: each series a colour, for profiles and curves a closing note shows.
@@ -140,12 +152,5 @@ pub fn lines(path: &Path, caption: &str, axes: (&str, &str), series: &[(&str, Ve
             .label(*name)
             .legend(move |(x, y)| PathElement::new([(x - 8, y), (x + 8, y)], color.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(|e| plot_error(path, e))?;
-    root.present().map_err(|e| plot_error(path, e))
+    legend_and_present(&mut chart, &root, path, SeriesLabelPosition::UpperRight, 14)
 }
