@@ -222,3 +222,25 @@ fn the_centred_form_beats_the_outer_only_form_on_every_suite_scene() {
     }
     finish(e);
 }
+
+/// A caster's own terminator is soft: the part of the light behind a convex caster's tangent
+/// plane is hidden, and the rest is not, so on the sphere (which nothing else shadows) V where
+/// the reference is in penumbra is the visible fraction of the light, not the hard 0 or 1 of
+/// the light's centre.
+#[test]
+fn a_convex_casters_terminator_follows_the_light_above_its_tangent_plane() {
+    let s = suite_scene("sphere");
+    let mut e = engine();
+    let truth = reference(&mut e, &s, 128);
+    let v = render_with(&mut e, &s, "plateau", &[], 128);
+    finish(e);
+    let (a, b) = (&v.surfaces, &truth.surfaces);
+    let terminator: Vec<f64> = (0..v.visibility.len())
+        .filter(|&i| a.casts[i] && b.casts[i] && (a.depth[i] - b.depth[i]).abs() <= 1e-3 * a.depth[i])
+        .filter(|&i| a.normal[i].dot(b.normal[i]) >= 0.99 && (1311..64224).contains(&truth.visibility[i]))
+        .map(|i| (v.visibility[i] as f64 - truth.visibility[i] as f64) / 65535.0)
+        .collect();
+    assert!(terminator.len() >= 30, "{} sphere pixels in the reference's penumbra", terminator.len());
+    let rmse = (terminator.iter().map(|e| e * e).sum::<f64>() / terminator.len() as f64).sqrt();
+    assert!(rmse <= 0.05, "RMSE {rmse} over the sphere's {} terminator pixels", terminator.len());
+}

@@ -52,7 +52,11 @@ void main() {
         out_visibility = 1.0;
         return;
     }
-    if (hides_itself(s, frame.light.xyz)) {
+    // A caster's own surface hides the part of the light behind its tangent plane: the soft
+    // terminator of an area light, exact for a convex caster (the plateau holds no shadow of a
+    // caster on itself).
+    float self_lit = in_front_of_itself(s, frame.light.xyz, frame.light.w);
+    if (self_lit == 0.0) {
         out_visibility = 0.0;
         return;
     }
@@ -65,7 +69,7 @@ void main() {
         float h = dot(s.p - o, n);
         float hl = dot(frame.light.xyz - o, n);
         if (!OFF_PLANE_MAP || s.casts || h >= hl) {
-            out_visibility = 1.0;
+            out_visibility = self_lit;
             return;
         }
         // From p along the ray, not from the light: light + (p − light)·hl/(hl − h) rounds p

@@ -46,6 +46,9 @@
 //! Off the plane, receivers are unshadowed (`off_plane = 0`) or read the texture where the ray
 //! from the light through them meets the plane, the projected light map of §2 (`off_plane = 1`;
 //! casters themselves keep only their self-shadowing, since the map holds their own shadow).
+//! That self-shadowing is soft: the fraction of the light sphere in front of the surface's
+//! tangent plane, exact for a convex caster (the hard test at the light's centre put most of
+//! the suite's remaining penumbra error on the casters' terminators: sphere 0.110 → 0.017).
 
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
