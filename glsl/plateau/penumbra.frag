@@ -6,11 +6,14 @@
 // reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
 // has shadow on both sides and writes nothing, so no bright streak crosses the umbra.
 //
-// Overlapping casters. Channel r holds, over a caster's hard shadow, that caster's bands only
-// (the mask holds the lowest caster where hard shadows overlap), so one caster's inner penumbra
-// never lightens what another blocks. Another caster's outer penumbra over that hard shadow goes
-// to channel g instead, if its edge bounds that caster's own shadow: each blocks part of the
-// light, and the resolve multiplies the two (Chan & Durand Fig. 10's overlapping penumbrae).
+// Overlapping casters. Each caster's bands go to one channel, r for odd caster numbers and g
+// for even ones, and the resolve multiplies the two channels' visibilities: blockers in
+// different channels count as independent (Chan & Durand Fig. 10's overlapping penumbrae), so
+// two crossing outer penumbrae multiply instead of the darkest winning; within a channel the
+// darkest still wins. Over a caster's hard shadow (the mask holds the lowest caster where hard
+// shadows overlap), that caster's channel holds its bands only, so one caster's inner penumbra
+// never lightens what another blocks; another caster's outer penumbra there goes to the other
+// channel, if its edge bounds that caster's own shadow.
 layout(constant_id = 0) const bool CENTRED = false;
 // More than one caster: the mask may hold another caster's number where a side is drawn. With
 // one, it holds only this caster's or none, and the texel under the fragment need not be read.
@@ -34,6 +37,11 @@ uint caster_at(vec2 texel) {
     return uint(round(texelFetch(mask, i, 0).r * 65535.0));
 }
 
+// t in the channel of caster number `caster` (r odd, g even), the other left lit.
+vec2 in_channel(uint caster, float t) {
+    return caster % 2u == 1u ? vec2(t, 1.0) : vec2(1.0, t);
+}
+
 void main() {
     out_t = vec2(in_t, 1.0);
     if (!CENTRED) {
@@ -54,6 +62,7 @@ void main() {
         if (caster_at(foot + probe) != 0u && caster_at(foot - probe) != 0u) {
             discard;
         }
+        out_t = in_channel(in_caster, in_t);
         return;
     }
     uint a = caster_at(foot + probe), b = caster_at(foot - probe);
@@ -63,5 +72,5 @@ void main() {
     if (!outer_half || (a == in_caster && b == in_caster)) {
         discard;
     }
-    out_t = vec2(1.0, in_t);
+    out_t = in_channel(here + 1u, in_t);
 }

@@ -3,8 +3,8 @@
 // falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
 // Outer only (the paper), t is 0 under the hard shadow mask. Centred (issue 20), t is the
 // distance to the hard edge in half widths, signed by the mask (negative inside), and the curve
-// spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge; times, over a hard shadow,
-// what other casters' outer penumbrae there let through (channel g, see penumbra.frag).
+// spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge, in each of two channels
+// (odd and even casters, see penumbra.frag), whose visibilities multiply.
 #include "interface.glsl"
 #include "camera.glsl"
 #include "falloff.glsl"
@@ -26,12 +26,23 @@ layout(set = 0, binding = 6) uniform sampler2D falloff;
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// One texel's curve parameters: t outside the mask; inside, 0 (outer only) or −t (centred);
-// and the other casters' outer t.
+// One texel's curve parameters. Outer only: t, 0 inside the mask. Centred, per channel (odd
+// and even casters, see penumbra.frag): t, or −t in the channel of the caster whose hard shadow
+// covers the texel.
 vec2 texel_s(ivec2 i) {
     vec2 t = texelFetch(plateau_texture, i, 0).rg;
-    bool shadowed = texelFetch(umbra_mask, i, 0).r > 0.0;
-    return vec2(shadowed ? (CENTRED ? -t.r : 0.0) : t.r, t.g);
+    uint caster = uint(round(texelFetch(umbra_mask, i, 0).r * 65535.0));
+    if (!CENTRED) {
+        return vec2(caster > 0u ? 0.0 : t.r, 1.0);
+    }
+    bvec2 own = bvec2(caster % 2u == 1u, caster > 0u && caster % 2u == 0u);
+    return mix(t, -t, own);
+}
+
+// A channel's visibility: every curve ends at 1, so a lit channel (most of the frame) skips the
+// falloff texture.
+float channel_v(float s) {
+    return s < 1.0 ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * s) : 1.0;
 }
 
 // Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
@@ -85,9 +96,6 @@ void main() {
         return;
     }
     vec2 signed_t = plateau_s(tc);
-    // Other casters' outer penumbrae reach few pixels: elsewhere g is 1, and so is its factor
-    // (every curve ends at 1), which is not read.
-    float others = CENTRED && signed_t.y < 1.0 ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.y) : 1.0;
-    out_visibility = CENTRED ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * signed_t.x) * others
-                             : falloff_at(falloff, FALLOFF, signed_t.x);
+    // Centred, the two channels' blockers are independent: their visibilities multiply.
+    out_visibility = CENTRED ? channel_v(signed_t.x) * channel_v(signed_t.y) : falloff_at(falloff, FALLOFF, signed_t.x);
 }
