@@ -4,7 +4,8 @@
 // Outer only (the paper), t is 0 under the hard shadow mask. Centred (issue 20), t is the
 // distance to the hard edge in half widths, signed by the mask (negative inside), and the curve
 // spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge, in each of two channels
-// (odd and even casters, see penumbra.frag), whose visibilities multiply.
+// (odd and even casters, see penumbra.frag), whose blockers count as independent: their
+// visibilities multiply.
 #include "interface.glsl"
 #include "camera.glsl"
 #include "falloff.glsl"
@@ -39,21 +40,29 @@ vec2 texel_s(ivec2 i) {
     return mix(t, -t, own);
 }
 
-// A channel's visibility: every curve ends at 1, so a lit channel (most of the frame) skips the
-// falloff texture.
+// A channel's visibility: every curve maps 0 to 0 and 1 to 1, so umbra and lit texels (most
+// of the frame) skip the falloff texture.
 float channel_v(float s) {
-    return s < 1.0 ? falloff_at(falloff, FALLOFF, 0.5 + 0.5 * s) : 1.0;
+    return s >= 1.0 ? 1.0 : (s <= -1.0 ? 0.0 : falloff_at(falloff, FALLOFF, 0.5 + 0.5 * s));
 }
 
-// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
-// 0 on the hard edge the sign flips without a step.
-vec2 plateau_s(vec2 tc) {
+// What is interpolated between texels: centred, V itself, the two channels' visibilities
+// multiplied per texel (where the caster covering the texel changes, the channels swap roles,
+// and their parameters interpolated apart drew a lit seam through the umbra); outer only, t.
+float texel_value(ivec2 i) {
+    vec2 s = texel_s(i);
+    return CENTRED ? channel_v(s.x) * channel_v(s.y) : s.x;
+}
+
+// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and centred,
+// where t is 0 on the hard edge, V is ½ on both sides of it.
+float plateau_bilinear(vec2 tc) {
     vec2 size = vec2(textureSize(plateau_texture, 0));
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     ivec2 i = ivec2(floor(pos));
     vec2 f = fract(pos);
-    vec2 a = mix(texel_s(i), texel_s(i + ivec2(1, 0)), f.x);
-    vec2 b = mix(texel_s(i + ivec2(0, 1)), texel_s(i + ivec2(1, 1)), f.x);
+    float a = mix(texel_value(i), texel_value(i + ivec2(1, 0)), f.x);
+    float b = mix(texel_value(i + ivec2(0, 1)), texel_value(i + ivec2(1, 1)), f.x);
     return mix(a, b, f.y);
 }
 
@@ -95,7 +104,6 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    vec2 signed_t = plateau_s(tc);
-    // Centred, the two channels' blockers are independent: their visibilities multiply.
-    out_visibility = CENTRED ? channel_v(signed_t.x) * channel_v(signed_t.y) : falloff_at(falloff, FALLOFF, signed_t.x);
+    float value = plateau_bilinear(tc);
+    out_visibility = CENTRED ? value : falloff_at(falloff, FALLOFF, value);
 }
