@@ -24,6 +24,15 @@ fn plate(half: f32, height: f32, light_height: f32, radius: f32, x: f32, view: f
     top_down(x, view, [0.0, light_height, 0.0], radius, &object)
 }
 
+/// The default plateau and the reference, `size`² each.
+fn plateau_and_reference(s: &Scene, size: u32) -> (Capture, Capture) {
+    let mut e = engine();
+    let truth = reference(&mut e, s, size);
+    let v = render_with(&mut e, s, "plateau", &[], size);
+    finish(e);
+    (v, truth)
+}
+
 /// V along the image's middle row.
 fn row(c: &Capture) -> Vec<f32> {
     (0..c.width).map(|x| c.visibility_at(x, c.height / 2)).collect()
@@ -228,11 +237,7 @@ fn the_centred_form_beats_the_outer_only_form_on_every_suite_scene() {
 /// the light's centre.
 #[test]
 fn a_convex_casters_terminator_follows_the_light_above_its_tangent_plane() {
-    let s = suite_scene("sphere");
-    let mut e = engine();
-    let truth = reference(&mut e, &s, 128);
-    let v = render_with(&mut e, &s, "plateau", &[], 128);
-    finish(e);
+    let (v, truth) = plateau_and_reference(&suite_scene("sphere"), 128);
     let (a, b) = (&v.surfaces, &truth.surfaces);
     let terminator: Vec<f64> = (0..v.visibility.len())
         .filter(|&i| a.casts[i] && b.casts[i] && (a.depth[i] - b.depth[i]).abs() <= 1e-3 * a.depth[i])
@@ -287,10 +292,7 @@ fn abutting_hard_shadows_leave_no_seam_in_the_umbra() {
         "[camera]\nposition = [0.0, 6.0, 5.0]\ntarget = [0.147, 0.0, 0.72]\nfov_y_deg = 2.0\n\
          [light]\nposition = [0.5, 8.0, 0.5]\nradius = 0.6\n[ground]\nheight = 0.0\n{objects}"
     ));
-    let mut e = engine();
-    let truth = reference(&mut e, &s, 96);
-    let v = render_with(&mut e, &s, "plateau", &[], 96);
-    finish(e);
+    let (v, truth) = plateau_and_reference(&s, 96);
     let (a, b) = (&v.surfaces, &truth.surfaces);
     let umbra: Vec<usize> = (0..v.visibility.len())
         .filter(|&i| a.receives[i] && !a.casts[i] && b.receives[i] && !b.casts[i] && truth.visibility[i] == 0)
