@@ -29,7 +29,10 @@ layout(location = 0) out float out_visibility;
 
 // One texel's curve parameters. Outer only: t, 0 inside the mask. Centred, per channel (odd
 // and even casters, see penumbra.frag): t, or −t in the channel of the caster whose hard shadow
-// covers the texel.
+// covers the texel; and where either channel is umbra (s ≤ −1, V = 0 whatever the other says),
+// both are. Where two casters' hard shadows abut, the channels swap roles between texels (one
+// caster's umbra beside the other's outer band), and interpolated apart they drew a lit seam
+// through the umbra (V up to 0.1 on overlap's ground).
 vec2 texel_s(ivec2 i) {
     vec2 t = texelFetch(plateau_texture, i, 0).rg;
     uint caster = uint(round(texelFetch(umbra_mask, i, 0).r * 65535.0));
@@ -37,32 +40,25 @@ vec2 texel_s(ivec2 i) {
         return vec2(caster > 0u ? 0.0 : t.r, 1.0);
     }
     bvec2 own = bvec2(caster % 2u == 1u, caster > 0u && caster % 2u == 0u);
-    return mix(t, -t, own);
+    vec2 s = mix(t, -t, own);
+    return min(s.x, s.y) <= -1.0 ? vec2(-1.0) : s;
 }
 
-// A channel's visibility: every curve maps 0 to 0 and 1 to 1, so umbra and lit texels (most
+// A channel's visibility: every curve maps 0 to 0 and 1 to 1, so lit and umbra channels (most
 // of the frame) skip the falloff texture.
 float channel_v(float s) {
     return s >= 1.0 ? 1.0 : (s <= -1.0 ? 0.0 : falloff_at(falloff, FALLOFF, 0.5 + 0.5 * s));
 }
 
-// What is interpolated between texels: centred, V itself, the two channels' visibilities
-// multiplied per texel (where the caster covering the texel changes, the channels swap roles,
-// and their parameters interpolated apart drew a lit seam through the umbra); outer only, t.
-float texel_value(ivec2 i) {
-    vec2 s = texel_s(i);
-    return CENTRED ? channel_v(s.x) * channel_v(s.y) : s.x;
-}
-
-// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and centred,
-// where t is 0 on the hard edge, V is ½ on both sides of it.
-float plateau_bilinear(vec2 tc) {
+// Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
+// 0 on the hard edge the sign flips without a step.
+vec2 plateau_s(vec2 tc) {
     vec2 size = vec2(textureSize(plateau_texture, 0));
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     ivec2 i = ivec2(floor(pos));
     vec2 f = fract(pos);
-    float a = mix(texel_value(i), texel_value(i + ivec2(1, 0)), f.x);
-    float b = mix(texel_value(i + ivec2(0, 1)), texel_value(i + ivec2(1, 1)), f.x);
+    vec2 a = mix(texel_s(i), texel_s(i + ivec2(1, 0)), f.x);
+    vec2 b = mix(texel_s(i + ivec2(0, 1)), texel_s(i + ivec2(1, 1)), f.x);
     return mix(a, b, f.y);
 }
 
@@ -104,6 +100,7 @@ void main() {
         out_visibility = 1.0; // beyond the shadow's footprint
         return;
     }
-    float value = plateau_bilinear(tc);
-    out_visibility = CENTRED ? value : falloff_at(falloff, FALLOFF, value);
+    vec2 signed_t = plateau_s(tc);
+    // Centred, the two channels' blockers count as independent: their visibilities multiply.
+    out_visibility = CENTRED ? channel_v(signed_t.x) * channel_v(signed_t.y) : falloff_at(falloff, FALLOFF, signed_t.x);
 }
