@@ -49,7 +49,7 @@
 //! That self-shadowing is soft: the fraction of the light sphere in front of the surface's
 //! tangent plane, exact for a convex caster (the hard test at the light's centre put most of
 //! the suite's remaining penumbra error on the casters' terminators: bench's penumbra RMSE on
-//! the sphere 0.110 → 0.016, low_light 0.206 → 0.044). Off the plane, shadows of other casters
+//! the sphere 0.110 → 0.016, low_light 0.206 → 0.046). Off the plane, shadows of other casters
 //! are still missing (two_boxes' box 2 under box 1, overlap's low plate: most of their error).
 
 use ash::vk;
