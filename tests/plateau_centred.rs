@@ -6,7 +6,9 @@
 
 mod common;
 
-use common::{engine, error_minimising_scale, finish, reference, render_with, scene, suite_scene, top_down};
+use common::{
+    engine, error_minimising_scale, finish, reference, render_with, scene, suite_scene, terminator_error, top_down,
+};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -238,15 +240,9 @@ fn the_centred_form_beats_the_outer_only_form_on_every_suite_scene() {
 #[test]
 fn a_convex_casters_terminator_follows_the_light_above_its_tangent_plane() {
     let (v, truth) = plateau_and_reference(&suite_scene("sphere"), 128);
-    let (a, b) = (&v.surfaces, &truth.surfaces);
-    let terminator: Vec<f64> = (0..v.visibility.len())
-        .filter(|&i| a.casts[i] && b.casts[i] && (a.depth[i] - b.depth[i]).abs() <= 1e-3 * a.depth[i])
-        .filter(|&i| a.normal[i].dot(b.normal[i]) >= 0.99 && (1311..64224).contains(&truth.visibility[i]))
-        .map(|i| (v.visibility[i] as f64 - truth.visibility[i] as f64) / 65535.0)
-        .collect();
-    assert!(terminator.len() >= 30, "{} sphere pixels in the reference's penumbra", terminator.len());
-    let rmse = (terminator.iter().map(|e| e * e).sum::<f64>() / terminator.len() as f64).sqrt();
-    assert!(rmse <= 0.05, "RMSE {rmse} over the sphere's {} terminator pixels", terminator.len());
+    let (pixels, rmse) = terminator_error(&v, &truth);
+    assert!(pixels >= 30, "{pixels} sphere pixels in the reference's penumbra");
+    assert!(rmse <= 0.05, "RMSE {rmse} over the sphere's {pixels} terminator pixels");
 }
 
 /// Two bars at different heights whose shadows cross like a +, under a light off to the side so

@@ -94,22 +94,28 @@ void main() {
         out_visibility = 1.0;
         return;
     }
-    if (hides_itself(s, frame.light.xyz)) {
+    // A caster's own surface hides the part of the light behind its tangent plane: the soft
+    // terminator of an area light (exact for a convex caster), where the hard test at the
+    // light's centre put most of the centred smoothie's remaining error on the casters. Past
+    // the terminator the map and the caster's own smoothies see the same blocker, so the two
+    // combine by the darker, not multiplied (which counts it twice).
+    float self_lit = in_front_of_itself(s, frame.light.xyz, frame.light.w);
+    if (self_lit == 0.0) {
         out_visibility = 0.0;
         return;
     }
     ShadowLookup l = shadow_lookup(light, frame.light.xyz, s.p, s.n);
     if (!l.inside) {
-        out_visibility = 1.0;
+        out_visibility = self_lit;
         return;
     }
     float umbra = compare_bilinear(shadow_map, vec2(0.0), light.bias.w, l.uv, l.depth);
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
     // falloff texture.
     if (CENTRED) {
-        out_visibility = centred_test(l.uv, l.depth, umbra);
+        out_visibility = min(self_lit, centred_test(l.uv, l.depth, umbra));
         return;
     }
     float v = umbra > 0.0 ? min(umbra, outer_test(l.uv, l.depth)) : 0.0;
-    out_visibility = v > 0.0 && v < 1.0 ? falloff_at(falloff, FALLOFF, v) : v;
+    out_visibility = min(self_lit, v > 0.0 && v < 1.0 ? falloff_at(falloff, FALLOFF, v) : v);
 }

@@ -153,13 +153,8 @@ impl LitCasters {
 
 pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
     assert_eq!((v.width, v.height), (truth.width, truth.height), "same size");
-    let (a, b) = (&v.surfaces, &truth.surfaces);
     let lit: Vec<bool> = (0..v.visibility.len())
-        .map(|i| {
-            let (da, db) = (a.depth[i], b.depth[i]);
-            let same = (da - db).abs() <= 1e-3 * da.max(db) && a.normal[i].dot(b.normal[i]) >= 0.99;
-            a.casts[i] && b.casts[i] && same && truth.visibility[i] >= (0.99 * 65535.0) as u16
-        })
+        .map(|i| same_caster_surface(v, truth, i) && truth.visibility[i] >= (0.99 * 65535.0) as u16)
         .collect();
     let (w, h) = (v.width as i64, v.height as i64);
     let mut m = LitCasters::default();
@@ -177,6 +172,26 @@ pub fn lit_casters(v: &Capture, truth: &Capture) -> LitCasters {
         m.interior += usize::from((-1..=1).all(|dy| (-1..=1).all(|dx| inside(dx, dy))));
     }
     m
+}
+
+/// Pixel `i` shows the same caster surface in both captures: a caster in each, at the same depth
+/// and facing the same way.
+fn same_caster_surface(v: &Capture, truth: &Capture, i: usize) -> bool {
+    let (a, b) = (&v.surfaces, &truth.surfaces);
+    let (da, db) = (a.depth[i], b.depth[i]);
+    a.casts[i] && b.casts[i] && (da - db).abs() <= 1e-3 * da.max(db) && a.normal[i].dot(b.normal[i]) >= 0.99
+}
+
+/// A caster's own terminator: its pixels where the reference is in penumbra (V in 0.02..0.98),
+/// and the RMSE of `v` against the reference over them.
+pub fn terminator_error(v: &Capture, truth: &Capture) -> (usize, f64) {
+    assert_eq!((v.width, v.height), (truth.width, truth.height), "same size");
+    let errors: Vec<f64> = (0..v.visibility.len())
+        .filter(|&i| same_caster_surface(v, truth, i) && (1311..64224).contains(&truth.visibility[i]))
+        .map(|i| (v.visibility[i] as f64 - truth.visibility[i] as f64) / 65535.0)
+        .collect();
+    let rmse = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
+    (errors.len(), rmse)
 }
 
 /// The scale among `scales` (values of `knob`, ascending, with `fixed` knobs set too) at which
