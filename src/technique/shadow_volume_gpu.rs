@@ -3,8 +3,10 @@
 //! (`glsl/shadow_volume/silhouettes.comp`) extracts the silhouette edges, extrudes them and
 //! emits the caps into one vertex buffer, in the ranges of three indirect draws per caster
 //! group (sides, caps, turned caps), which the counting passes draw. The vertices are the CPU
-//! path's, so the counts, and V, are the same. Each mesh's positions, triangles and edges are
-//! uploaded once; the vertex buffer holds one point's volumes and is rebuilt for the next.
+//! path's, and so is the facing test (the mesh's face planes against the light taken into
+//! object space on the host, the same operations in the same order), so the counts, and V, are
+//! the same. Each mesh's positions, triangles, edges and face planes are uploaded once; the
+//! vertex buffer holds one point's volumes and is rebuilt for the next.
 
 use ash::vk;
 use bytemuck::{Pod, cast_slice};
@@ -15,6 +17,7 @@ use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::VolumeParams;
 use crate::geometry::NO_FACE;
+use crate::geometry::silhouette::FacePlanes;
 use crate::gpu::{
     Buffer, BufferAccess, Context, Descriptor, PerFrame, Pipeline, Uploads, buffer_barrier, dispatch, draw_indirect,
     shaders, upload,
@@ -30,12 +33,13 @@ const VERTEX_BYTES: u64 = 20;
 /// Draws per caster group and point: sides, caps, turned caps.
 pub const PARTS: usize = 3;
 
-/// One mesh on the GPU: positions, triangles and edges in one buffer, and the most vertices
-/// each part of its volume can take.
+/// One mesh on the GPU: positions, triangles, edges and face planes in one buffer, and the
+/// most vertices each part of its volume can take.
 struct MeshData {
     buffer: Buffer,
     triangles_at: u32,
     edges_at: u32,
+    planes_at: u32,
     triangles: u32,
     edges: u32,
     most: [u32; PARTS],
@@ -50,6 +54,8 @@ impl MeshData {
         data.extend(mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]));
         let edges_at = data.len() as u32;
         data.extend(edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]));
+        let planes_at = data.len() as u32;
+        data.extend((0..mesh.triangles.len()).map(|f| mesh.planes.plane(f).to_array().map(f32::to_bits)));
         let buffer = upload(ctx, cmd, "volume mesh", cast_slice(&data), vk::BufferUsageFlags::STORAGE_BUFFER)?;
         // An edge is extruded once per face on it, at most; a triangle gives a dark and a light
         // cap, or a dark and a turned one.
@@ -59,6 +65,7 @@ impl MeshData {
             buffer,
             triangles_at,
             edges_at,
+            planes_at,
             triangles,
             edges: edges.len() as u32,
             most: [6 * faces, 6 * triangles, 3 * triangles],
@@ -100,15 +107,20 @@ impl GpuVolumes {
     }
 
     /// Lays out this frame's volumes: for every point and caster of `groups` (scene object
-    /// indices, each with whether it takes the two-sided construction) its params, for every
-    /// point and group its three draw commands, each range sized for the most it can take.
-    pub fn prepare(&mut self, frame: &FrameInputs<'_>, points: &[Vec3], groups: &[Vec<(usize, bool)>]) -> Result<()> {
+    /// indices, each with the mesh it casts from and whether that takes the two-sided
+    /// construction) its params, for every point and group its three draw commands, each range
+    /// sized for the most it can take.
+    pub fn prepare(
+        &mut self,
+        frame: &FrameInputs<'_>,
+        points: &[Vec3],
+        groups: &[Vec<(usize, &Mesh, bool)>],
+    ) -> Result<()> {
         let ctx = frame.ctx;
         self.dispatches.clear();
         self.groups = groups.len();
         for (g, group) in groups.iter().enumerate() {
-            for &(object, two_sided) in group {
-                let mesh = &frame.scene.objects[object].mesh;
+            for &(object, mesh, two_sided) in group {
                 let at = self.meshes.index(ctx, mesh.id(), || MeshData::new(ctx, frame.cmd, mesh))?;
                 self.dispatches.push(Dispatch { mesh: at, object, group: g, two_sided });
             }
@@ -137,13 +149,12 @@ impl GpuVolumes {
                 let command = |k: usize| ((p * groups.len() + d.group) * PARTS + k) as u32;
                 let [sides, caps, turned] = ranges[d.group];
                 params.push(VolumeParams {
-                    model: object.transform.matrix(),
-                    light: q.extend(1.0),
+                    light: FacePlanes::object_light(&object.transform.matrix(), *q),
                     counts: [mesh.edges, mesh.triangles, d.two_sided as u32, frame.draws[d.object].instance],
-                    offsets: [mesh.triangles_at, mesh.edges_at, 0, 0],
+                    offsets: [mesh.triangles_at, mesh.edges_at, mesh.planes_at, 0],
                     commands: [command(0), command(1), command(2), 0],
                     ends: [sides.1, caps.1, turned.1, 0],
-                    pad: [Vec4::ZERO; 7],
+                    pad: [Vec4::ZERO; 11],
                 });
             }
         }
