@@ -322,6 +322,8 @@ fn silhouettes_are_timed_apart_from_the_fill() {
     for (gpu, counting) in [("0", "2"), ("1", "2"), ("1", "1")] {
         let sets = [("gpu_silhouettes", gpu), ("counting", counting)];
         for _ in 0..2 {
+            // The light moves: the compute path builds its volumes again every frame.
+            s.light.position.x += 0.01;
             render_with(&mut e, &s, "shadow-volume", &sets, 64);
         }
         e.flush().unwrap();
@@ -414,5 +416,52 @@ fn a_simplified_shadow_mesh_keeps_the_volumes_closed_and_within_its_error() {
     let own = render_with(&mut e, &receiving, "shadow-volume", &[], size);
     let kept = render_with(&mut e, &receiving, "shadow-volume", &[("shadow_mesh_error", "4")], size);
     assert_eq!(own.visibility, kept.visibility, "a receiving caster casts from its own mesh");
+    finish(e);
+}
+
+/// Names of the GPU passes of every frame rendered since the last call.
+fn passes_per_frame(e: &mut softshadow::Engine) -> Vec<Vec<&'static str>> {
+    e.flush().unwrap();
+    e.take_timings().iter().map(|t| t.passes.iter().map(|p| p.name).collect()).collect()
+}
+
+/// The compute path (`gpu_silhouettes = 1`) under one light point keeps its volumes while
+/// nothing moves: a static scene records no silhouette pass after its first frame, and draws
+/// the same shadow from the kept volumes; a moved caster or light builds them again, and the
+/// image follows (as the CPU path's).
+#[test]
+fn the_compute_path_builds_volumes_only_when_something_moved() {
+    let mut s = suite_scene("two_boxes");
+    s.light.radius = 0.0;
+    let mut e = engine();
+    let mut frame = common::settings(&s, 64, 64);
+    frame.params = softshadow::technique::Params::defaults(softshadow::technique::find("shadow-volume").unwrap());
+    frame.params.set("gpu_silhouettes", "1").unwrap();
+    let first = e.render_and_capture(&s, &frame).unwrap();
+    for _ in 0..3 {
+        e.render(&s, &frame).unwrap();
+    }
+    let still = e.render_and_capture(&s, &frame).unwrap();
+    let static_frames = passes_per_frame(&mut e);
+    assert!(static_frames[0].contains(&"silhouettes"), "{static_frames:?}");
+    assert!(static_frames[1..].iter().all(|p| !p.contains(&"silhouettes")), "{static_frames:?}");
+    assert!(static_frames.iter().all(|p| p.contains(&"volumes")), "{static_frames:?}");
+    assert_eq!(still.visibility, first.visibility, "the kept volumes cast the first frame's shadow");
+    let caster = s.objects.iter().position(|o| o.casts).unwrap();
+    s.objects[caster].transform.position.x += 0.3;
+    let moved = e.render_and_capture(&s, &frame).unwrap();
+    e.render(&s, &frame).unwrap();
+    s.light.position.z += 0.5;
+    let lit_anew = e.render_and_capture(&s, &frame).unwrap();
+    let moving_frames = passes_per_frame(&mut e);
+    let built: Vec<bool> = moving_frames.iter().map(|p| p.contains(&"silhouettes")).collect();
+    assert_eq!(built, [true, false, true], "{moving_frames:?}");
+    let mut cpu_light = s.clone();
+    cpu_light.light.position.z -= 0.5;
+    for (gpu, scene) in [(&moved, &cpu_light), (&lit_anew, &s)] {
+        let cpu = render_with(&mut e, scene, "shadow-volume", &[], 64);
+        assert_eq!(gpu.visibility, cpu.visibility, "the rebuilt volumes are the moved scene's");
+    }
+    assert!(moved.visibility != first.visibility && lit_anew.visibility != moved.visibility);
     finish(e);
 }

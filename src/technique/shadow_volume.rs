@@ -3,7 +3,8 @@
 //!
 //! Per light point, in the papers' order: `silhouettes` (on the CPU, the shared silhouette
 //! code, cached while nothing moves, a CPU span of the timings; or with `gpu_silhouettes` a
-//! compute pass, [`GpuVolumes`], a GPU one), `volumes` (the silhouette edges extruded to infinity,
+//! compute pass, [`GpuVolumes`], a GPU one, not recorded while nothing moves under one light
+//! point), `volumes` (the silhouette edges extruded to infinity,
 //! w = 0, counted by two-sided stencil in one pass), `caps` (z-fail only: the light caps, the
 //! caster's light-facing triangles, and the dark caps at infinity), then the stencil resolved
 //! into V: 0 is lit, anything else shadowed ([`Accumulation`]), and `resolve`.
@@ -418,7 +419,7 @@ impl Technique for ShadowVolumes {
         let caps = z_fail || reach > 0.0;
         span(frame, !timed, "accumulate");
         for p in 0..points.len() {
-            if let Some(gpu) = self.gpu.as_ref().filter(|_| on_gpu) {
+            if let Some(gpu) = self.gpu.as_ref().filter(|g| on_gpu && g.building()) {
                 span(frame, timed, "silhouettes");
                 gpu.record(frame, p)?;
                 end_span(frame, timed);
