@@ -419,12 +419,6 @@ fn a_simplified_shadow_mesh_keeps_the_volumes_closed_and_within_its_error() {
     finish(e);
 }
 
-/// Names of the GPU passes of every frame rendered since the last call.
-fn passes_per_frame(e: &mut softshadow::Engine) -> Vec<Vec<&'static str>> {
-    e.flush().unwrap();
-    e.take_timings().iter().map(|t| t.passes.iter().map(|p| p.name).collect()).collect()
-}
-
 /// The compute path (`gpu_silhouettes = 1`) under one light point keeps its volumes while
 /// nothing moves: a static scene records no silhouette pass after its first frame, and draws
 /// the same shadow from the kept volumes; a moved caster or light builds them again, and the
@@ -434,15 +428,7 @@ fn the_compute_path_builds_volumes_only_when_something_moved() {
     let mut s = suite_scene("two_boxes");
     s.light.radius = 0.0;
     let mut e = engine();
-    let mut frame = common::settings(&s, 64, 64);
-    frame.params = softshadow::technique::Params::defaults(softshadow::technique::find("shadow-volume").unwrap());
-    frame.params.set("gpu_silhouettes", "1").unwrap();
-    let first = e.render_and_capture(&s, &frame).unwrap();
-    for _ in 0..3 {
-        e.render(&s, &frame).unwrap();
-    }
-    let still = e.render_and_capture(&s, &frame).unwrap();
-    let static_frames = passes_per_frame(&mut e);
+    let (frame, first, still, static_frames) = common::static_compute_frames(&mut e, &s, "shadow-volume");
     assert!(static_frames[0].contains(&"silhouettes"), "{static_frames:?}");
     assert!(static_frames[1..].iter().all(|p| !p.contains(&"silhouettes")), "{static_frames:?}");
     assert!(static_frames.iter().all(|p| p.contains(&"volumes")), "{static_frames:?}");
@@ -453,7 +439,7 @@ fn the_compute_path_builds_volumes_only_when_something_moved() {
     e.render(&s, &frame).unwrap();
     s.light.position.z += 0.5;
     let lit_anew = e.render_and_capture(&s, &frame).unwrap();
-    let moving_frames = passes_per_frame(&mut e);
+    let moving_frames = common::passes_per_frame(&mut e);
     let built: Vec<bool> = moving_frames.iter().map(|p| p.contains(&"silhouettes")).collect();
     assert_eq!(built, [true, false, true], "{moving_frames:?}");
     let mut cpu_light = s.clone();
