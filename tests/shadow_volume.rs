@@ -451,3 +451,29 @@ fn the_compute_path_builds_volumes_only_when_something_moved() {
     assert!(moved.visibility != first.visibility && lit_anew.visibility != moved.visibility);
     finish(e);
 }
+
+/// The CPU path writes a frame slot's volume vertices again only when what they hold changed:
+/// a light moved from side to side, frame after frame (the boxes' silhouettes change with it),
+/// casts each frame the shadow a fresh engine draws for that light.
+#[test]
+fn kept_volume_vertices_follow_every_move() {
+    let mut s = suite_scene("two_boxes");
+    s.light.radius = 0.0;
+    let rest = s.light.position;
+    let lit_from = |side: usize| {
+        let mut moved = s.clone();
+        moved.light.position = rest + Vec3::X * [-2.0, 2.0][side];
+        moved
+    };
+    let mut fresh = engine();
+    let truth: Vec<Capture> =
+        (0..2).map(|side| render_with(&mut fresh, &lit_from(side), "shadow-volume", &[], 64)).collect();
+    finish(fresh);
+    assert!(truth[0].visibility != truth[1].visibility);
+    let mut e = engine();
+    for (k, side) in [0, 0, 0, 1, 1, 0, 1, 0, 0].into_iter().enumerate() {
+        let v = render_with(&mut e, &lit_from(side), "shadow-volume", &[], 64);
+        assert!(v.visibility == truth[side].visibility, "frame {k}: not the shadow of that light");
+    }
+    finish(e);
+}

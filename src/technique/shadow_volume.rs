@@ -64,8 +64,8 @@ use crate::geometry::shadow_volume::{ShadowVolume, eye_may_be_in_shadow, is_open
 use crate::geometry::silhouette::Caster;
 use crate::geometry::{Aabb, Projection};
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
-    TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Guard, PerFrame, Pipeline, PipelineDesc,
+    RenderPass, Target, TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
 };
 use crate::scene::{Mesh, MeshId, Object};
 
@@ -123,6 +123,16 @@ struct VolumeKey {
     points: Vec<Vec3>,
 }
 
+/// What a frame slot's volume vertices were written from: every object's volumes, the groups,
+/// the objects' indices, the buffer's size (a grown buffer holds nothing yet).
+#[derive(Clone, Debug, PartialEq)]
+struct Written {
+    volumes: Vec<Option<VolumeKey>>,
+    groups: Vec<Vec<usize>>,
+    instances: Vec<u32>,
+    capacity: u64,
+}
+
 /// What a mesh's volumes need, found once: whether it takes the two-sided construction, and
 /// its nesting bound.
 #[derive(Clone, Copy, Debug)]
@@ -144,6 +154,8 @@ pub struct ShadowVolumes {
     accumulation: Accumulation,
     format: vk::Format,
     vertices: Option<PerFrame>,
+    /// Per frame slot: what its copy of `vertices` holds, and its ranges.
+    written: [Option<(Written, Vec<GroupRange>)>; FRAMES_IN_FLIGHT],
     depth_stencil: Option<Target>,
     /// Per scene object: its volumes, one per light point, and what they were built from.
     volumes: Vec<Option<(VolumeKey, Vec<ShadowVolume>)>>,
@@ -203,6 +215,7 @@ impl ShadowVolumes {
             accumulation,
             format,
             vertices: None,
+            written: Default::default(),
             depth_stencil: None,
             volumes: Vec::new(),
             facts: Vec::new(),
@@ -285,7 +298,11 @@ impl ShadowVolumes {
         points: usize,
         groups: &[Vec<usize>],
     ) -> (Vec<f32>, Vec<GroupRange>) {
-        let mut out = Vec::new();
+        let triangles: usize = (self.volumes.iter().flatten())
+            .flat_map(|(_, v)| v)
+            .map(|v| v.sides.len() + v.far_caps.len() + v.near_caps.len() + v.turned_caps.len())
+            .sum();
+        let mut out = Vec::with_capacity(3 * VERTEX_FLOATS * triangles);
         let mut ranges = Vec::with_capacity(points * groups.len());
         for p in 0..points {
             for group in groups {
@@ -384,13 +401,28 @@ impl Technique for ShadowVolumes {
         } else {
             let start = Instant::now();
             self.build(frame, &meshes, &points);
-            let (vertices, ranges) = self.vertices(frame, &meshes, points.len(), &groups);
-            if !vertices.is_empty() {
-                let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-                let bytes: &[u8] = cast_slice(&vertices);
-                PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
-                    .write(frame.slot, bytes);
-            }
+            // The slot's vertices are written again only when what they hold changed.
+            let mut written = Written {
+                volumes: self.volumes.iter().map(|v| v.as_ref().map(|(k, _)| k.clone())).collect(),
+                groups: groups.clone(),
+                instances: frame.draws.iter().map(|d| d.instance).collect(),
+                capacity: self.vertices.as_ref().map_or(0, PerFrame::capacity),
+            };
+            let ranges = match &self.written[frame.slot] {
+                Some((w, ranges)) if *w == written => ranges.clone(),
+                _ => {
+                    let (vertices, ranges) = self.vertices(frame, &meshes, points.len(), &groups);
+                    if !vertices.is_empty() {
+                        let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+                        let bytes: &[u8] = cast_slice(&vertices);
+                        PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
+                            .write(frame.slot, bytes);
+                    }
+                    written.capacity = self.vertices.as_ref().map_or(0, PerFrame::capacity);
+                    self.written[frame.slot] = Some((written, ranges.clone()));
+                    ranges
+                }
+            };
             frame.cpu_spans.push(("silhouettes", start.elapsed().as_secs_f64() * 1e3));
             ranges
         };
