@@ -1,29 +1,42 @@
-//! Per-frame CPU cost of the shadow volumes' CPU path on the largest shipped model (wingnut,
-//! 6090 triangles), as a frame whose caster or light moved rebuilds them: face facing, the
-//! sides of every edge by its multiplicity, light and dark caps. The GPU path does the same in
-//! its `silhouettes` compute pass (`softshadow render --set gpu_silhouettes=1 --timings`).
+//! Per-frame CPU cost of the shadow volumes' CPU path, as a frame whose caster moved rebuilds
+//! them: face facing from the mesh's face planes against the light taken into object space,
+//! the sides of every edge by its multiplicity, light and dark caps; on the largest suite model
+//! (wingnut, 6090 triangles) and at scale (koala, 99 994 triangles, issue 18). No vertex is
+//! transformed: the volumes are vertex numbers, drawn from the object-space positions. The GPU
+//! path does the same in its `silhouettes` compute pass
+//! (`softshadow render --set gpu_silhouettes=1 --timings`).
 
-use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::shadow_volume::{is_open, shadow_volume};
-use softshadow::geometry::silhouette::{Caster, light_facing};
+use softshadow::geometry::silhouette::Caster;
 use softshadow::scene::Mesh;
 
 fn volumes(c: &mut Criterion) {
-    let wingnut = Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/wingnut.obj")).unwrap();
-    let model = Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0));
-    let positions: Vec<Vec3> = wingnut.positions.iter().map(|p| model.transform_point3(*p)).collect();
-    let caster = Caster { positions: &positions, triangles: &wingnut.triangles, adjacency: &wingnut.adjacency };
-    let light = Vec3::new(3.0, 9.0, 2.5);
-    c.bench_function("shadow volume (facing, sides, caps), wingnut", |b| {
-        b.iter(|| {
-            let facing = light_facing(black_box(&caster), light);
-            shadow_volume(&caster, &facing, is_open(&caster))
-        })
-    });
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("models");
+    let wingnut = Mesh::load_obj(&models.join("wingnut.obj")).unwrap();
+    let koala = Mesh::load_obj(&models.join("koala.obj")).unwrap();
+    // As scenes/scale/koala.toml places it: standing, 1.4 m tall, over the ground.
+    let koala_model = Mat4::from_translation(Vec3::new(0.0, 0.7, 0.0))
+        * Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
+        * Mat4::from_scale(Vec3::splat(0.15));
+    for (name, mesh, model, light) in [
+        ("wingnut", &wingnut, Mat4::from_translation(Vec3::Y), Vec3::new(3.0, 9.0, 2.5)),
+        ("koala", &koala, koala_model, Vec3::new(2.0, 7.0, 1.5)),
+    ] {
+        let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let two_sided = is_open(&caster);
+        let mut step = 0.0f32;
+        c.bench_function(&format!("shadow volume, moving frame (facing, sides, caps), {name}"), |b| {
+            b.iter(|| {
+                step += 1e-3;
+                let model = Mat4::from_translation(Vec3::X * step) * model;
+                shadow_volume(&caster, &mesh.planes.light_facing(&model, light), two_sided)
+            })
+        });
+    }
 }
 
 criterion_group!(benches, volumes);

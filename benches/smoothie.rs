@@ -6,26 +6,29 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
+use softshadow::geometry::fit_spot_frustum;
 use softshadow::geometry::silhouette::Caster;
 use softshadow::geometry::smoothie::{Penumbra, SmoothieSize, silhouette, smoothies};
-use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Mesh;
 
 fn smoothie(c: &mut Criterion) {
     let wingnut = Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/wingnut.obj")).unwrap();
-    let positions: Vec<Vec3> = wingnut.positions.iter().map(|p| *p + Vec3::Y).collect();
-    let caster = Caster { positions: &positions, triangles: &wingnut.triangles, adjacency: &wingnut.adjacency };
+    // As the technique does: object-space positions and face planes, placed by the model.
+    let model = Mat4::from_translation(Vec3::Y);
+    let caster = Caster { positions: &wingnut.positions, triangles: &wingnut.triangles, adjacency: &wingnut.adjacency };
     let light = Vec3::new(3.0, 9.0, 2.5);
     let mut group = c.benchmark_group("smoothie, wingnut");
     group.throughput(Throughput::Elements(wingnut.adjacency.edges.len() as u64));
-    group.bench_function("silhouette edges", |b| b.iter(|| silhouette(black_box(&caster), light)));
-    let edges = silhouette(&caster, light);
+    group.bench_function("silhouette edges", |b| {
+        b.iter(|| silhouette(black_box(&caster), &wingnut.planes, black_box(&model), light))
+    });
+    let edges = silhouette(&caster, &wingnut.planes, &model, light);
     // The light view a frame would fit: around the model, cut to a ground square under it.
-    let bounds = Aabb::from_points(positions.iter().copied());
+    let bounds = wingnut.bounds.transformed(&model);
     let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
-    let view = frustum.view;
+    let view = frustum.view * model;
     let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
     group.bench_function("smoothie geometry", |b| {
         b.iter(|| smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer))

@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides};
-use softshadow::geometry::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
+use softshadow::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Scene;
@@ -57,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
         let source = if mesh.adjacency.is_closed() { EdgeSource::Silhouettes } else { EdgeSource::LightFacing };
         let started = Instant::now();
-        let facing = light_facing(&caster, light);
+        let facing = mesh.planes.light_facing(&model, light);
         let edges = penumbra_edges(&caster, &facing, source);
         let edges_ms = started.elapsed().as_secs_f64() * 1e3;
         let closed_edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);

@@ -12,7 +12,7 @@
 //! `cargo run --release --example volume_fill [SIZE] [FRAMES]` (default 512, 8).
 
 use softshadow::geometry::shadow_volume::{is_open, screen_fill, shadow_volume};
-use softshadow::geometry::silhouette::{Caster, light_facing};
+use softshadow::geometry::silhouette::Caster;
 use softshadow::geometry::{Aabb, CameraProjection};
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::TimingReport;
@@ -49,7 +49,7 @@ fn fill(scene: &Scene, aspect: f32) -> Result<(f64, f64), String> {
         let model = o.transform.matrix();
         let positions: Vec<_> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
         let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-        let volume = shadow_volume(&caster, &light_facing(&caster, light), is_open(&caster));
+        let volume = shadow_volume(&caster, &o.mesh.planes.light_facing(&model, light), is_open(&caster));
         sides += screen_fill(&volume, &positions, light, camera.view_proj, false);
         all += screen_fill(&volume, &positions, light, camera.view_proj, true);
     }

@@ -137,15 +137,17 @@ fn depth_bytes(depth: &[f32], format: vk::Format) -> Vec<u8> {
 
 /// The embedder's depth prepass on the GPU: its own pipeline, descriptor set, buffers and
 /// dynamic rendering pass, drawing the scene's meshes (objects, then the ground) into its D32
-/// reverse-Z depth. Its stages are the engine's published prepass shaders (the fragment stage
-/// writes the ground's depth as the camera ray's exact hit on its plane, as the engine does), so
+/// reverse-Z depth. Its stages are the engine's published prepass shaders, the objects' and the
+/// ground's pipelines as the engine's (the ground's fragment stage writes its depth as the
+/// camera ray's exact hit on its plane), so
 /// that its depth is the engine's bit for bit: V then has nothing to differ by but the engine's
 /// own work (a ray-cast depth differs in the last bits, and PCF moved by up to 5 LSB on 9 pixels;
 /// a rasterized ground, by 3 LSB on 1).
 struct DepthPrepass {
     set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
-    pipeline: vk::Pipeline,
+    /// The objects' pipeline and the ground's.
+    pipelines: [vk::Pipeline; 2],
     pool: vk::DescriptorPool,
     set: vk::DescriptorSet,
     buffers: [HostBuffer; 4],
@@ -243,14 +245,16 @@ impl DepthPrepass {
             let layout =
                 d.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts), None).unwrap();
             let published = [
-                (vk::ShaderStageFlags::VERTEX, softshadow::gpu::shaders::PREPASS_SCENE_VERT.words),
-                (vk::ShaderStageFlags::FRAGMENT, softshadow::gpu::shaders::PREPASS_SCENE_FRAG.words),
+                softshadow::gpu::shaders::PREPASS_SCENE_VERT.words,
+                softshadow::gpu::shaders::PREPASS_SCENE_FRAG.words,
+                softshadow::gpu::shaders::PREPASS_GROUND_FRAG.words,
             ];
-            let modules = published.map(|(_, code)| {
-                d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None).unwrap()
-            });
-            let stages = [0, 1].map(|i| {
-                vk::PipelineShaderStageCreateInfo::default().stage(published[i].0).module(modules[i]).name(c"main")
+            let modules = published
+                .map(|code| d.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(code), None).unwrap());
+            let stage =
+                |stage, module| vk::PipelineShaderStageCreateInfo::default().stage(stage).module(module).name(c"main");
+            let stages = [1, 2].map(|frag| {
+                [stage(vk::ShaderStageFlags::VERTEX, modules[0]), stage(vk::ShaderStageFlags::FRAGMENT, modules[frag])]
             });
             let stride = std::mem::size_of::<softshadow::scene::Vertex>() as u32;
             let vertex_bindings =
@@ -282,20 +286,22 @@ impl DepthPrepass {
             let blend = vk::PipelineColorBlendStateCreateInfo::default();
             let mut rendering =
                 vk::PipelineRenderingCreateInfo::default().depth_attachment_format(vk::Format::D32_SFLOAT);
-            let ci = [vk::GraphicsPipelineCreateInfo::default()
-                .stages(&stages)
-                .vertex_input_state(&vertex_input)
-                .input_assembly_state(&assembly)
-                .viewport_state(&viewport)
-                .rasterization_state(&raster)
-                .multisample_state(&multisample)
-                .depth_stencil_state(&depth)
-                .color_blend_state(&blend)
-                .layout(layout)
-                .push_next(&mut rendering)];
-            let pipeline = d.create_graphics_pipelines(vk::PipelineCache::null(), &ci, None).unwrap()[0];
+            let pipelines = stages.map(|stages| {
+                let ci = [vk::GraphicsPipelineCreateInfo::default()
+                    .stages(&stages)
+                    .vertex_input_state(&vertex_input)
+                    .input_assembly_state(&assembly)
+                    .viewport_state(&viewport)
+                    .rasterization_state(&raster)
+                    .multisample_state(&multisample)
+                    .depth_stencil_state(&depth)
+                    .color_blend_state(&blend)
+                    .layout(layout)
+                    .push_next(&mut rendering)];
+                d.create_graphics_pipelines(vk::PipelineCache::null(), &ci, None).unwrap()[0]
+            });
             modules.into_iter().for_each(|m| d.destroy_shader_module(m, None));
-            DepthPrepass { set_layout, layout, pipeline, pool, set, buffers, draws }
+            DepthPrepass { set_layout, layout, pipelines, pool, set, buffers, draws }
         }
     }
 
@@ -313,11 +319,18 @@ impl DepthPrepass {
             .depth_attachment(&attachment);
         unsafe {
             d.cmd_begin_rendering(cmd, &info);
-            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             d.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
             d.cmd_bind_vertex_buffers(cmd, 0, &[self.buffers[2].buffer], &[0]);
             d.cmd_bind_index_buffer(cmd, self.buffers[3].buffer, 0, vk::IndexType::UINT32);
+            let ground = self.draws.len() - 1;
             for (instance, &(count, first, offset)) in self.draws.iter().enumerate() {
+                if instance == 0 || instance == ground {
+                    d.cmd_bind_pipeline(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        self.pipelines[(instance == ground) as usize],
+                    );
+                }
                 d.cmd_draw_indexed(cmd, count, 1, first, offset, instance as u32);
             }
             d.cmd_end_rendering(cmd);
@@ -326,7 +339,7 @@ impl DepthPrepass {
 
     fn destroy(self, e: &Embedder) {
         unsafe {
-            e.device.destroy_pipeline(self.pipeline, None);
+            self.pipelines.into_iter().for_each(|p| e.device.destroy_pipeline(p, None));
             e.device.destroy_pipeline_layout(self.layout, None);
             e.device.destroy_descriptor_pool(self.pool, None);
             e.device.destroy_descriptor_set_layout(self.set_layout, None);

@@ -1,6 +1,9 @@
 //! The simplified shadow mesh (issue 18) keeps the shadow within its stated error: seen from
 //! the light, its outline strays from the full mesh's by no more than the bound in texels of
-//! the light's view ([`LIGHT_VIEW_TEXELS`]² fitted to the caster), with fewer triangles.
+//! the light's view ([`LIGHT_VIEW_TEXELS`]² fitted to the caster), with fewer triangles; and
+//! every path that casts from it does (the shadow volumes': tests/shadow_volume.rs).
+
+mod common;
 
 use std::sync::Arc;
 
@@ -75,4 +78,24 @@ fn the_simplified_shadow_mesh_stays_within_its_stated_error() {
     assert!(huge.adjacency.is_closed());
     // No error allowed: the full mesh itself.
     assert!(Arc::ptr_eq(&o.mesh.shadow_mesh(0.0), &o.mesh));
+}
+
+/// The smoothie's compute path (`gpu_silhouettes = 1`) casts from the simplified mesh as its CPU
+/// path does: the same smoothies from it, and not the full mesh's.
+#[test]
+fn the_smoothies_compute_path_casts_from_the_shadow_mesh_too() {
+    use common::{engine, finish, render_with, top_down};
+    use softshadow::measure::Metrics;
+    let knot = "[[object]]\nshape = \"knot\"\ntriangles = 20000\nposition = [0.0, 1.0, 0.0]\nscale = 0.8\n";
+    let s = top_down(0.0, 2.0, LIGHT.to_array(), 0.3, knot);
+    let mut e = engine();
+    let simple = [("shadow_mesh_error", "4")];
+    let gpu = [simple[0], ("gpu_silhouettes", "1")];
+    let cpu = render_with(&mut e, &s, "smoothie", &simple, 128);
+    let on_gpu = render_with(&mut e, &s, "smoothie", &gpu, 128);
+    let full = render_with(&mut e, &s, "smoothie", &[("gpu_silhouettes", "1")], 128);
+    let same = Metrics::between(&on_gpu, &cpu).unwrap().max_abs;
+    let apart = Metrics::between(&full, &cpu).unwrap().max_abs;
+    assert!(same < 0.01 && apart > 10.0 * same.max(1e-3), "GPU vs CPU {same}, full vs simplified {apart}");
+    finish(e);
 }

@@ -322,6 +322,8 @@ fn silhouettes_are_timed_apart_from_the_fill() {
     for (gpu, counting) in [("0", "2"), ("1", "2"), ("1", "1")] {
         let sets = [("gpu_silhouettes", gpu), ("counting", counting)];
         for _ in 0..2 {
+            // The light moves: the compute path builds its volumes again every frame.
+            s.light.position.x += 0.01;
             render_with(&mut e, &s, "shadow-volume", &sets, 64);
         }
         e.flush().unwrap();
@@ -341,6 +343,137 @@ fn silhouettes_are_timed_apart_from_the_fill() {
         assert_eq!(cpu[at - 1] == "silhouettes", gpu == "0", "{sets:?}: {cpu:?}");
         assert_eq!(cpu.iter().filter(|n| **n == "silhouettes").count(), (gpu == "0") as usize, "{cpu:?}");
         assert!(t.cpu.iter().all(|c| c.ms >= 0.0), "{t:?}");
+    }
+    finish(e);
+}
+
+/// A 20k-triangle knot over the ground, seen from above, under a point light; `receives` says
+/// whether the knot takes shadows itself.
+fn knot(receives: bool) -> softshadow::scene::Scene {
+    let knot = format!(
+        "[[object]]\nshape = \"knot\"\ntriangles = 20000\nposition = [0.0, 1.2, 0.0]\nscale = 0.8\nreceives = {receives}\n"
+    );
+    top_down(0.0, 2.0, KNOT_LIGHT, 0.0, &knot)
+}
+
+const KNOT_LIGHT: [f32; 3] = [1.0, 8.0, 0.5];
+
+/// `shadow_mesh_error` (issue 18): a caster that receives no shadow casts its volumes from the
+/// simplified mesh. Its hard shadow on the ground strays from the full mesh's by no more than
+/// the stated texels of the light's view, carried down to the ground; the volumes stay closed
+/// (sides, caps and nesting bound from the one simplified mesh), so z-pass and z-fail count
+/// alike off the edges and the GPU path as the CPU's; a caster that receives keeps its own mesh
+/// (a simplified light cap would stand over its lit side), so its image does not change.
+#[test]
+fn a_simplified_shadow_mesh_keeps_the_volumes_closed_and_within_its_error() {
+    use softshadow::technique::shadow_mesh::texels_at_caster;
+    let size = 256;
+    let s = knot(false);
+    let mut e = engine();
+    let full = render_with(&mut e, &s, "shadow-volume", ZPASS, size);
+    let full_dark = |x: i64, y: i64| {
+        let (x, y) = (x.clamp(0, size as i64 - 1) as u32, y.clamp(0, size as i64 - 1) as u32);
+        full.visibility_at(x, y) < 0.5
+    };
+    // World metres per screen pixel (an orthographic half height of 2 m), and how much farther
+    // from the light the ground is than the caster's nearest point, with a margin for the
+    // light's slant.
+    let pixel = 4.0 / size as f32;
+    let o = &s.objects[0];
+    let light = Vec3::from(KNOT_LIGHT);
+    let b = o.bounds();
+    let nearest = ((b.min + b.max) * 0.5 - light).length() - (b.max - b.min).length() * 0.5;
+    let to_ground = 1.25 * light.y / nearest;
+    // Larger errors open this knot, and the full mesh casts (Mesh::shadow_mesh).
+    for texels in [1.0f32, 4.0] {
+        let band = (texels_at_caster(o, light, texels).unwrap() * to_ground / pixel).ceil() as i64 + 1;
+        let knob = texels.to_string();
+        let zpass = render_with(&mut e, &s, "shadow-volume", &[ZPASS[0], ("shadow_mesh_error", &knob)], size);
+        let mut strays = 0;
+        for y in 0..size as i64 {
+            for x in 0..size as i64 {
+                let here = full_dark(x, y);
+                if (zpass.visibility_at(x as u32, y as u32) < 0.5) == here {
+                    continue;
+                }
+                strays += 1;
+                let near_outline = (-band..=band).any(|dy| (-band..=band).any(|dx| full_dark(x + dx, y + dy) != here));
+                assert!(near_outline, "{texels} texels: {x},{y} strays beyond {band} px of the full outline");
+            }
+        }
+        assert!(texels < 4.0 || strays > 0, "the simplified mesh casts: its outline differs somewhere");
+        let zfail = render_with(&mut e, &s, "shadow-volume", &[ZFAIL[0], ("shadow_mesh_error", &knob)], size);
+        assert_same_hard_shadow(&zfail, &zpass, &format!("{texels} texels, z-fail vs z-pass"));
+        for counting in [ZPASS[0], ZFAIL[0]] {
+            let cpu = if counting == ZPASS[0] { &zpass } else { &zfail };
+            let sets = [counting, ("shadow_mesh_error", &knob), ("gpu_silhouettes", "1")];
+            let gpu = render_with(&mut e, &s, "shadow-volume", &sets, size);
+            let worst = cpu.visibility.iter().zip(&gpu.visibility).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+            assert!(worst <= 65535 / 255, "{texels} texels {counting:?}: GPU differs by {worst}");
+        }
+    }
+    let receiving = knot(true);
+    let own = render_with(&mut e, &receiving, "shadow-volume", &[], size);
+    let kept = render_with(&mut e, &receiving, "shadow-volume", &[("shadow_mesh_error", "4")], size);
+    assert_eq!(own.visibility, kept.visibility, "a receiving caster casts from its own mesh");
+    finish(e);
+}
+
+/// The compute path (`gpu_silhouettes = 1`) under one light point keeps its volumes while
+/// nothing moves: a static scene records no silhouette pass after its first frame, and draws
+/// the same shadow from the kept volumes; a moved caster or light builds them again, and the
+/// image follows (as the CPU path's).
+#[test]
+fn the_compute_path_builds_volumes_only_when_something_moved() {
+    let mut s = suite_scene("two_boxes");
+    s.light.radius = 0.0;
+    let mut e = engine();
+    let (frame, first, still, static_frames) = common::static_compute_frames(&mut e, &s, "shadow-volume");
+    assert!(static_frames[0].contains(&"silhouettes"), "{static_frames:?}");
+    assert!(static_frames[1..].iter().all(|p| !p.contains(&"silhouettes")), "{static_frames:?}");
+    assert!(static_frames.iter().all(|p| p.contains(&"volumes")), "{static_frames:?}");
+    assert_eq!(still.visibility, first.visibility, "the kept volumes cast the first frame's shadow");
+    let caster = s.objects.iter().position(|o| o.casts).unwrap();
+    s.objects[caster].transform.position.x += 0.3;
+    let moved = e.render_and_capture(&s, &frame).unwrap();
+    e.render(&s, &frame).unwrap();
+    s.light.position.z += 0.5;
+    let lit_anew = e.render_and_capture(&s, &frame).unwrap();
+    let moving_frames = common::passes_per_frame(&mut e);
+    let built: Vec<bool> = moving_frames.iter().map(|p| p.contains(&"silhouettes")).collect();
+    assert_eq!(built, [true, false, true], "{moving_frames:?}");
+    let mut cpu_light = s.clone();
+    cpu_light.light.position.z -= 0.5;
+    for (gpu, scene) in [(&moved, &cpu_light), (&lit_anew, &s)] {
+        let cpu = render_with(&mut e, scene, "shadow-volume", &[], 64);
+        assert_eq!(gpu.visibility, cpu.visibility, "the rebuilt volumes are the moved scene's");
+    }
+    assert!(moved.visibility != first.visibility && lit_anew.visibility != moved.visibility);
+    finish(e);
+}
+
+/// The CPU path writes a frame slot's volume vertices again only when what they hold changed:
+/// a light moved from side to side, frame after frame (the boxes' silhouettes change with it),
+/// casts each frame the shadow a fresh engine draws for that light.
+#[test]
+fn kept_volume_vertices_follow_every_move() {
+    let mut s = suite_scene("two_boxes");
+    s.light.radius = 0.0;
+    let rest = s.light.position;
+    let lit_from = |side: usize| {
+        let mut moved = s.clone();
+        moved.light.position = rest + Vec3::X * [-2.0, 2.0][side];
+        moved
+    };
+    let mut fresh = engine();
+    let truth: Vec<Capture> =
+        (0..2).map(|side| render_with(&mut fresh, &lit_from(side), "shadow-volume", &[], 64)).collect();
+    finish(fresh);
+    assert!(truth[0].visibility != truth[1].visibility);
+    let mut e = engine();
+    for (k, side) in [0, 0, 0, 1, 1, 0, 1, 0, 0].into_iter().enumerate() {
+        let v = render_with(&mut e, &lit_from(side), "shadow-volume", &[], 64);
+        assert!(v.visibility == truth[side].visibility, "frame {k}: not the shadow of that light");
     }
     finish(e);
 }

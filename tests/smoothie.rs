@@ -188,25 +188,11 @@ fn the_compute_path_draws_the_same_smoothies_as_the_cpu() {
     finish(e);
 }
 
-/// Names of the GPU passes of every frame rendered since the last call.
-fn passes_per_frame(e: &mut softshadow::Engine) -> Vec<Vec<&'static str>> {
-    e.flush().unwrap();
-    e.take_timings().iter().map(|t| t.passes.iter().map(|p| p.name).collect()).collect()
-}
-
 #[test]
 fn the_compute_path_finds_silhouettes_only_when_something_moved() {
     let mut s = suite_scene("default");
     let mut e = engine();
-    let mut frame = common::settings(&s, 64, 64);
-    frame.params = softshadow::technique::Params::defaults(softshadow::technique::find("smoothie").unwrap());
-    frame.params.set("gpu_silhouettes", "1").unwrap();
-    let first = e.render_and_capture(&s, &frame).unwrap();
-    for _ in 0..3 {
-        e.render(&s, &frame).unwrap();
-    }
-    let still = e.render_and_capture(&s, &frame).unwrap();
-    let static_frames = passes_per_frame(&mut e);
+    let (mut frame, first, still, static_frames) = common::static_compute_frames(&mut e, &s, "smoothie");
     assert!(static_frames[0].contains(&"silhouettes"), "{static_frames:?}");
     assert!(static_frames[1..].iter().all(|p| !p.contains(&"silhouettes")), "{static_frames:?}");
     assert!(static_frames.iter().all(|p| p.contains(&"smoothie_buffer")), "{static_frames:?}");
@@ -217,14 +203,14 @@ fn the_compute_path_finds_silhouettes_only_when_something_moved() {
     s.objects[caster].transform.position.x += 0.3;
     let moved = e.render_and_capture(&s, &frame).unwrap();
     e.render(&s, &frame).unwrap();
-    let moved_frames = passes_per_frame(&mut e);
+    let moved_frames = common::passes_per_frame(&mut e);
     assert!(moved_frames[0].contains(&"silhouettes") && !moved_frames[1].contains(&"silhouettes"), "{moved_frames:?}");
     let cpu = render_with(&mut e, &s, "smoothie", &[], 64);
     assert!(Metrics::between(&moved, &cpu).unwrap().max_abs < 0.01);
     // Nothing moves but the penumbra's form changes: the kept output no longer applies.
     frame.params.set("penumbra", "0").unwrap();
     let outer = e.render_and_capture(&s, &frame).unwrap();
-    let outer_frames = passes_per_frame(&mut e);
+    let outer_frames = common::passes_per_frame(&mut e);
     assert!(outer_frames.last().unwrap().contains(&"silhouettes"), "{outer_frames:?}");
     let cpu = render_with(&mut e, &s, "smoothie", &[("penumbra", "0")], 64);
     assert!(Metrics::between(&outer, &cpu).unwrap().max_abs < 0.01);

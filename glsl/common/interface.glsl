@@ -68,13 +68,12 @@ struct SilhouetteParams {
 // One caster's shadow volume from one light point, built on the GPU (shadow-volume,
 // gpu_silhouettes = 1). 256 bytes, so one of an array can be bound as a uniform buffer.
 struct VolumeParams {
-    mat4 model;       // object -> world
-    vec4 light;       // xyz: the light point
+    vec4 light;       // the light point in object space, homogeneous, as the face-plane test takes it
     uvec4 counts;     // x: edges, y: triangles, z: 1 for the two-sided (open) construction, w: object index
-    uvec4 offsets;    // x: the mesh data's first triangle, y: its first edge (positions come first)
+    uvec4 offsets;    // x, y, z: the mesh data's first triangle, edge, face plane (positions come first)
     uvec4 commands;   // x, y, z: the draw commands of the sides, the caps, the turned caps
     uvec4 ends;       // x, y, z: the vertex where each of those ranges ends
-    vec4 pad[7];
+    vec4 pad[11];
 };
 
 // One hard shadow of an accumulation (shadow-volume, planar): the light point it is cast from and

@@ -12,7 +12,8 @@ const uint NO_FACE = 0xffffffffu;
 const uint FLOATS = 5u;
 
 layout(set = 0, binding = 0) uniform Params { VolumeParams params; };
-// Positions (float bits), then triangles, then edges (v0, v1, face0, face1).
+// Positions (float bits), then triangles, then edges (v0, v1, face0, face1), then face planes
+// (n, d; float bits).
 layout(std430, set = 0, binding = 1) readonly buffer Mesh { uvec4 mesh[]; };
 layout(std430, set = 0, binding = 2) buffer Commands { uvec4 commands[]; }; // count, 1, first, 0
 layout(std430, set = 0, binding = 3) writeonly buffer Vertices { float vertices[]; };
@@ -21,14 +22,12 @@ vec3 object_position(uint v) {
     return uintBitsToFloat(mesh[v].xyz);
 }
 
-// The host's light_facing, operation for operation (precise: no fused or reordered arithmetic),
-// so that both paths agree on every face but the exactly edge-on.
+// The host's FacePlanes::light_facing, operation for operation (precise: no fused or reordered
+// arithmetic), on the same planes and object-space light: both paths agree on every face.
 bool facing(uint f) {
-    uvec4 t = mesh[params.offsets.x + f];
-    precise vec3 a = (params.model * vec4(object_position(t.x), 1.0)).xyz;
-    precise vec3 b = (params.model * vec4(object_position(t.y), 1.0)).xyz;
-    precise vec3 c = (params.model * vec4(object_position(t.z), 1.0)).xyz;
-    precise float side = dot(cross(b - a, c - a), params.light.xyz - (a + b + c) / 3.0);
+    vec4 n = uintBitsToFloat(mesh[params.offsets.z + f]);
+    vec4 l = params.light;
+    precise float side = n.x * l.x + n.y * l.y + n.z * l.z + n.w * l.w;
     return side > 0.0;
 }
 

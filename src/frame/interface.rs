@@ -83,17 +83,18 @@ pub struct SilhouetteParams {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct VolumeParams {
-    pub model: Mat4,
+    /// The light point in the caster's object space, as the face-plane test takes it
+    /// (`FacePlanes::object_light`).
     pub light: Vec4,
     /// Edges, triangles, 1 for the two-sided construction, the object's index.
     pub counts: [u32; 4],
-    /// Where the mesh data's triangles and edges begin (positions come first).
+    /// Where the mesh data's triangles, edges and face planes begin (positions come first).
     pub offsets: [u32; 4],
     /// The indirect draw commands of the sides, the caps and the turned caps.
     pub commands: [u32; 4],
     /// The vertex where each of those ranges ends.
     pub ends: [u32; 4],
-    pub pad: [Vec4; 7],
+    pub pad: [Vec4; 11],
 }
 
 /// One hard shadow of an accumulation, padded to 256 bytes (see `LightSample`).

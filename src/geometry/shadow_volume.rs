@@ -60,8 +60,10 @@ pub fn is_open(caster: &Caster<'_>) -> bool {
     caster.adjacency.boundary + caster.adjacency.non_manifold > 0
 }
 
-/// The volume of `caster` (world positions) lit from the point `light`, its `facing` the
-/// caster's light-facing triangles ([`light_facing`](super::silhouette::light_facing)).
+/// The volume of `caster` lit from a point, its `facing` the caster's light-facing triangles
+/// from that point ([`FacePlanes::light_facing`](super::silhouette::FacePlanes::light_facing)).
+/// Connectivity alone: the corners are vertex numbers, in whatever space the caster's
+/// positions are, so a frame whose caster moved transforms none of them.
 pub fn shadow_volume(caster: &Caster<'_>, facing: &[bool], two_sided: bool) -> ShadowVolume {
     let blocks = |f: u32| f != NO_FACE && (two_sided || facing[f as usize]);
     // +1 when the face, turned towards the light, runs along the edge as stored.
@@ -203,7 +205,7 @@ mod tests {
     use super::*;
     use crate::geometry::EdgeAdjacency;
     use crate::geometry::shapes;
-    use crate::geometry::silhouette::light_facing;
+    use crate::geometry::silhouette::FacePlanes;
     use proptest::prelude::*;
 
     /// The signed number of times the closed triangle soup winds round `p` (solid angles summed,
@@ -265,7 +267,7 @@ mod tests {
     fn check(positions: &[Vec3], triangles: &[[u32; 3]], light: Vec3, probe: Vec3) -> Result<(), TestCaseError> {
         let adjacency = EdgeAdjacency::build(triangles);
         let caster = Caster { positions, triangles, adjacency: &adjacency };
-        let facing = light_facing(&caster, light);
+        let facing = FacePlanes::new(positions, triangles).light_facing(&Mat4::IDENTITY, light);
         let two_sided = is_open(&caster);
         let volume = shadow_volume(&caster, &facing, two_sided);
         let w = winding(&soup(&volume, positions, light, 1e4), probe);

@@ -6,7 +6,7 @@
 //! silhouette: facing from face planes built at load (four arrays, vectorised), then two facing
 //! flags per edge from the compact face pairs.
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
 use super::adjacency::EdgeAdjacency;
 
@@ -94,11 +94,23 @@ impl FacePlanes {
     /// transform that mirrors (negative determinant) turns every face round, as the world test
     /// sees it; a singular one lights none.
     pub fn light_facing(&self, model: &Mat4, light: Vec3) -> Facing {
-        let side = model.determinant().signum();
-        let l = (model.inverse().transform_point3(light) * side).extend(side);
+        let l = Self::object_light(model, light);
         let planes = self.nx.iter().zip(&self.ny).zip(&self.nz).zip(&self.d);
         let lit = planes.map(|(((x, y), z), d)| x * l.x + y * l.y + z * l.z + d * l.w > 0.0);
         Facing::collect(self.d.len(), lit)
+    }
+
+    /// `light` (world) taken into the object space of `model` as [`Self::light_facing`] tests
+    /// it: homogeneous, negated by a mirroring transform, so that face `f` faces the light
+    /// exactly when `plane(f) · l > 0`, summed x, y, z, w in that order.
+    pub fn object_light(model: &Mat4, light: Vec3) -> Vec4 {
+        let side = model.determinant().signum();
+        (model.inverse().transform_point3(light) * side).extend(side)
+    }
+
+    /// Face `f`'s plane: n in xyz, d in w.
+    pub fn plane(&self, f: usize) -> Vec4 {
+        Vec4::new(self.nx[f], self.ny[f], self.nz[f], self.d[f])
     }
 }
 
@@ -232,7 +244,8 @@ mod tests {
     fn silhouette(triangles: &[[u32; 3]], positions: &[Vec3], light: Vec3) -> Vec<([u32; 2], u32)> {
         let adjacency = EdgeAdjacency::build(triangles);
         let caster = Caster { positions, triangles, adjacency: &adjacency };
-        let mut edges = penumbra_edges(&caster, &light_facing(&caster, light), EdgeSource::Silhouettes);
+        let facing = FacePlanes::new(positions, triangles).light_facing(&Mat4::IDENTITY, light);
+        let mut edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
         edges.sort_unstable();
         edges
     }

@@ -26,7 +26,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::Aabb;
-use super::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
+use super::silhouette::{Caster, EdgeSource, FacePlanes, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 const MIN_DEPTH: f32 = 1e-6;
@@ -159,10 +159,11 @@ fn quad(out: &mut Vec<SmoothieVertex>, v: [SmoothieVertex; 4]) {
     out.extend([v[0], v[1], v[2], v[0], v[2], v[3]]);
 }
 
-/// The silhouette edges of a caster relative to the light at `light` (boundary edges of open
-/// meshes count as silhouettes), each with the third vertex of its light-facing triangle.
-pub fn silhouette(caster: &Caster<'_>, light: Vec3) -> Vec<([u32; 2], u32)> {
-    penumbra_edges(caster, &light_facing(caster, light), EdgeSource::Silhouettes)
+/// The silhouette edges of a caster placed by `model`, its `planes` built from its positions,
+/// relative to the light at `light` (world; boundary edges of open meshes count as
+/// silhouettes), each with the third vertex of its light-facing triangle.
+pub fn silhouette(caster: &Caster<'_>, planes: &FacePlanes, model: &Mat4, light: Vec3) -> Vec<([u32; 2], u32)> {
+    penumbra_edges(caster, &planes.light_facing(model, light), EdgeSource::Silhouettes)
 }
 
 /// One end of a projected silhouette edge at a silhouette vertex: where the vertex lies, its
@@ -299,7 +300,7 @@ mod tests {
         fn edges_extend_outward_by_t_and_corners_are_radial(height in 0.5f32..5.0, t in 0.001f32..0.5) {
             let (positions, triangles, adjacency) = plate(height);
             let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-            let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+            let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
             prop_assert_eq!(edges.len(), 4, "a plate under the light: its outline");
             let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), Penumbra::Outer);
             prop_assert!(g.inner.is_empty(), "outer only: no inner quads");
@@ -381,7 +382,7 @@ mod tests {
         fn inner_quads_mirror_the_edges_over_the_blocker(height in 0.5f32..5.0, t in 0.001f32..0.2) {
             let (positions, triangles, adjacency) = plate(height);
             let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-            let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+            let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
             let size = (SmoothieSize::Fixed(t), f32::INFINITY);
             let g = smoothies(&down(), &caster, &edges, size, CENTRED);
             prop_assert_eq!(g.inner.len(), 4 * 6, "one inner quad per silhouette edge");
@@ -418,7 +419,8 @@ mod tests {
     fn vertices_behind_the_light_and_point_edges_are_skipped() {
         let (positions, triangles, adjacency) = plate(12.0); // above the light at y = 10
         let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-        let edges = silhouette(&caster, Vec3::new(0.0, 10.0, 0.0));
+        let edges =
+            silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
         let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(0.1), f32::INFINITY), CENTRED);
         assert!(g.is_empty());
     }

@@ -192,6 +192,19 @@ pub fn dispatch(ctx: &Context, cmd: vk::CommandBuffer, groups: u32) {
     unsafe { ctx.device.cmd_dispatch(cmd, groups, 1, 1) };
 }
 
+/// Copies the first `size` bytes of `src` to `dst` from the command buffer (a copy-stage
+/// transfer: [`BufferAccess::TRANSFER_WRITE`](super::BufferAccess::TRANSFER_WRITE) on `dst`).
+pub fn copy_buffer(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src: vk::DescriptorBufferInfo,
+    dst: vk::DescriptorBufferInfo,
+    size: u64,
+) {
+    let region = vk::BufferCopy { src_offset: src.offset, dst_offset: dst.offset, size };
+    unsafe { ctx.device.cmd_copy_buffer(cmd, src.buffer, dst.buffer, &[region]) };
+}
+
 /// Writes `data` (at most 64 KiB, a multiple of 4 bytes) into `dst` from the command buffer.
 pub fn update_buffer(ctx: &Context, cmd: vk::CommandBuffer, dst: vk::DescriptorBufferInfo, data: &[u8]) {
     unsafe { ctx.device.cmd_update_buffer(cmd, dst.buffer, dst.offset, data) };

@@ -427,7 +427,13 @@ impl Engine {
         clock.mark("draw list");
         let targets = self.targets.as_mut().expect("ensured");
         targets.ensure_shaded(ctx)?;
-        self.prepass.as_ref().expect("built").record(ctx, &mut frame, targets, prepared.inputs(), &prepared.draws)?;
+        self.prepass.as_ref().expect("built").record(
+            ctx,
+            &mut frame,
+            targets,
+            prepared.inputs(),
+            prepared.surfaces(),
+        )?;
         clock.mark("prepass");
         let (_, technique) = self.technique.as_mut().expect("ensured");
         let mut inputs = prepared.frame_inputs(ctx, &mut frame, scene, &targets.depth, &targets.normal);

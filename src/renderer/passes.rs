@@ -6,8 +6,8 @@ use super::CameraTargets;
 use crate::error::Result;
 use crate::frame::{Draw, MESH_POSITIONS_NORMALS};
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, Frame, Fullscreen, Pipeline, PipelineDesc, RenderPass, Target,
-    fullscreen, is_srgb, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, Frame, Fullscreen, Guard, Pipeline, PipelineDesc, RenderPass,
+    Target, fullscreen, is_srgb, shaders, transition,
 };
 
 /// Facet normal + shadow role, read by the techniques.
@@ -18,29 +18,38 @@ pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 pub const COLOR_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 
 /// Camera prepass: reverse-Z depth, facet normal with the shadow role, shading normal, albedo.
+/// The meshes first, with the depth test before their shader (`glsl/prepass/scene.frag`), then
+/// the ground, which writes its exact depth (`glsl/prepass/ground.frag`) and so is tested after
+/// its shader: a shader that writes depth anywhere would turn the early test off for
+/// everything it draws.
 pub struct Prepass {
-    pipeline: Pipeline,
+    meshes: Pipeline,
+    ground: Pipeline,
 }
 
 impl Prepass {
     pub fn new(ctx: &Context) -> Result<Self> {
-        let desc = PipelineDesc::new("prepass", &shaders::PREPASS_SCENE_VERT, &shaders::PREPASS_SCENE_FRAG)
-            .vertex_input(MESH_POSITIONS_NORMALS)
-            .colors(&[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT])
-            // Reverse Z: nearer is greater.
-            .depth(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::GREATER));
-        let pipeline = Pipeline::new(ctx, &desc)?;
-        Ok(Prepass { pipeline })
+        let desc = |name, frag| {
+            PipelineDesc::new(name, &shaders::PREPASS_SCENE_VERT, frag)
+                .vertex_input(MESH_POSITIONS_NORMALS)
+                .colors(&[NORMAL_FORMAT, SHADING_FORMAT, ALBEDO_FORMAT])
+                // Reverse Z: nearer is greater.
+                .depth(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::GREATER))
+        };
+        let meshes = Guard::new(ctx, Pipeline::new(ctx, &desc("prepass", &shaders::PREPASS_SCENE_FRAG))?);
+        let ground = Pipeline::new(ctx, &desc("prepass ground", &shaders::PREPASS_GROUND_FRAG))?;
+        Ok(Prepass { meshes: meshes.keep(), ground })
     }
 
-    /// Draws everything; leaves depth and normal ready for the technique and the composite.
+    /// Draws the meshes, then the ground, in the draw list's order; leaves depth and normal
+    /// ready for the technique and the composite.
     pub fn record(
         &self,
         ctx: &Context,
         frame: &mut Frame<'_>,
         t: &mut CameraTargets,
         inputs: [vk::DescriptorBufferInfo; 2],
-        draws: &[Draw],
+        (meshes, ground): (&[Draw], Option<&Draw>),
     ) -> Result<()> {
         let cmd = frame.cmd;
         frame.timer.begin(ctx, cmd, "prepass");
@@ -65,9 +74,14 @@ impl Prepass {
             ],
             Some(Attachment::clear_depth(&t.depth, 0.0)),
         );
-        self.pipeline.bind(ctx, cmd, &inputs.map(Descriptor::Buffer))?;
-        for draw in draws {
+        let inputs = inputs.map(Descriptor::Buffer);
+        self.meshes.bind(ctx, cmd, &inputs)?;
+        for draw in meshes {
             draw.record(ctx, cmd);
+        }
+        if let Some(ground) = ground {
+            self.ground.bind(ctx, cmd, &inputs)?;
+            ground.record(ctx, cmd);
         }
         pass.end(ctx, cmd);
         transition(
@@ -85,7 +99,8 @@ impl Prepass {
     }
 
     pub fn destroy(self, ctx: &Context) {
-        self.pipeline.destroy(ctx);
+        self.meshes.destroy(ctx);
+        self.ground.destroy(ctx);
     }
 }
 

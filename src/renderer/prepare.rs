@@ -37,6 +37,8 @@ pub(super) struct Prepared {
     pub globals: vk::DescriptorBufferInfo,
     pub objects: vk::DescriptorBufferInfo,
     pub receivers: Vec<Vec3>,
+    /// Whether the last draw is the ground's.
+    ground: bool,
 }
 
 impl FrameData {
@@ -135,6 +137,7 @@ impl FrameData {
             draws,
             camera,
             receivers,
+            ground: scene.ground.is_some(),
         })
     }
 }
@@ -143,6 +146,14 @@ impl Prepared {
     /// The frame globals and object buffer, as the prepass and import pass bind them.
     pub fn inputs(&self) -> [vk::DescriptorBufferInfo; 2] {
         [self.globals, self.objects]
+    }
+
+    /// The meshes' draws and the ground's, which the prepass draws with a pipeline of its own.
+    pub fn surfaces(&self) -> (&[Draw], Option<&Draw>) {
+        match self.draws.split_last() {
+            Some((ground, meshes)) if self.ground => (meshes, Some(ground)),
+            _ => (&self.draws, None),
+        }
     }
 
     /// What the technique reads, with the camera surfaces in `depth` and `normal`.

@@ -3,10 +3,12 @@
 //! ([`Mesh::shadow_mesh`]) while the camera still draws the full one. The error bound is in
 //! texels of the light's view, so a technique sets it where a texel is what it can show.
 
+use std::sync::Arc;
+
 use glam::Vec3;
 
 use super::knobs::{Knob, Params};
-use crate::scene::Object;
+use crate::scene::{Mesh, Object};
 
 /// Declared by each technique that casts from [`shadow_caster`].
 pub const SHADOW_MESH_ERROR: Knob = Knob {
@@ -35,15 +37,18 @@ pub fn texels_at_caster(o: &Object, light: Vec3, texels: f32) -> Option<f32> {
     })
 }
 
-/// `o` as its shadow is cast: with [`SHADOW_MESH_ERROR`] set, a copy whose mesh is the
-/// simplified one within that many texels (converted through the largest scale to the mesh's
-/// own units); otherwise `o` unchanged.
-pub fn shadow_caster(o: &Object, light: Vec3, params: &Params) -> Object {
+/// The mesh `o` casts from: with [`SHADOW_MESH_ERROR`] set, the simplified one within that
+/// many texels (converted through the largest scale to the mesh's own units); otherwise its
+/// own.
+pub fn shadow_mesh(o: &Object, light: Vec3, params: &Params) -> Arc<Mesh> {
     let texels = params.get(&SHADOW_MESH_ERROR) as f32;
-    let world = if texels > 0.0 { texels_at_caster(o, light, texels) } else { None };
-    let mut o = o.clone();
-    if let Some(world) = world {
-        o.mesh = o.mesh.shadow_mesh(world / o.transform.scale.abs().max_element());
+    match if texels > 0.0 { texels_at_caster(o, light, texels) } else { None } {
+        Some(world) => o.mesh.shadow_mesh(world / o.transform.scale.abs().max_element()),
+        None => o.mesh.clone(),
     }
-    o
+}
+
+/// `o` as its shadow is cast: a copy whose mesh is [`shadow_mesh`]'s.
+pub fn shadow_caster(o: &Object, light: Vec3, params: &Params) -> Object {
+    Object { mesh: shadow_mesh(o, light, params), ..o.clone() }
 }

@@ -3,7 +3,8 @@
 //!
 //! Per light point, in the papers' order: `silhouettes` (on the CPU, the shared silhouette
 //! code, cached while nothing moves, a CPU span of the timings; or with `gpu_silhouettes` a
-//! compute pass, [`GpuVolumes`], a GPU one), `volumes` (the silhouette edges extruded to infinity,
+//! compute pass, [`GpuVolumes`], a GPU one, not recorded while nothing moves under one light
+//! point), `volumes` (the silhouette edges extruded to infinity,
 //! w = 0, counted by two-sided stencil in one pass), `caps` (z-fail only: the light caps, the
 //! caster's light-facing triangles, and the dark caps at infinity), then the stencil resolved
 //! into V: 0 is lit, anything else shadowed ([`Accumulation`]), and `resolve`.
@@ -29,11 +30,21 @@
 //! bias anywhere: self-shadowing comes from the counts alone (light caps have the surface's
 //! depth to the bit, `glsl/shadow_volume/volume.vert`).
 //!
+//! Shadow mesh (issue 18, `shadow_mesh_error`; the DDJ's "separate shadowing and drawing
+//! models"): a caster that receives no shadow casts its volumes from the simplified mesh
+//! (`Mesh::shadow_mesh`, within the knob's texels of the light's view), sides, caps, nesting
+//! bound and two-sided choice all from that one mesh, so every volume stays closed and the
+//! counts whole, z-fail included (the simplifier keeps a closed mesh closed, or the full mesh
+//! casts). A caster that receives keeps its own mesh: the counts start at its drawn surface
+//! with no bias, and a simplified light cap standing over that surface would put the caster's
+//! own lit side inside its volume, shadowing it in patches.
+//!
 //! Counts beyond the stencil's bits: volumes are counted modulo 128 in the low 7 bits, casters
 //! taken in groups whose nesting bounds (`nesting_bound`) sum to at most 127, and each group's
 //! non-zero pixels marked in the top bit before the next group counts. One caster alone that
 //! could nest more than 127 times in itself is the one case left to the modulo.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use ash::vk;
@@ -43,27 +54,34 @@ use glam::{Mat4, Vec3, Vec4};
 use super::accumulation::{Accumulation, SAMPLES, StencilRule, end_span, span, stencil};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_mesh};
 use super::shadow_volume_gpu::{GpuVolumes, PARTS};
 use super::{Technique, clear_visibility};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SampleView;
 use crate::geometry::shadow_volume::{ShadowVolume, eye_may_be_in_shadow, is_open, nesting_bound, shadow_volume};
-use crate::geometry::silhouette::{Caster, light_facing};
+use crate::geometry::silhouette::Caster;
 use crate::geometry::{Aabb, Projection};
 use crate::gpu::{
-    Access, Attachment, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass, Target,
-    TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
+    Access, Attachment, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Guard, PerFrame, Pipeline, PipelineDesc,
+    RenderPass, Target, TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
 };
-use crate::scene::MeshId;
+use crate::scene::{Mesh, MeshId, Object};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "shadow-volume",
     summary: "stencil shadow volumes: silhouettes extruded to infinity, z-pass or z-fail; N accumulated for soft",
     kind: Kind::Realtime,
-    knobs: &[SAMPLES, COUNTING, GPU_SILHOUETTES],
+    knobs: &[SAMPLES, COUNTING, GPU_SILHOUETTES, SHADOW_MESH_ERROR],
     create: |ctx, _, visibility| Ok(Box::new(ShadowVolumes::new(ctx, visibility)?)),
-    bench: &[&[], &[("counting", "2")], &[("gpu_silhouettes", "1")], &[("samples", "16")]],
+    bench: &[
+        &[],
+        &[("counting", "2")],
+        &[("gpu_silhouettes", "1")],
+        &[("samples", "16")],
+        &[("shadow_mesh_error", "1")],
+    ],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,
@@ -105,6 +123,16 @@ struct VolumeKey {
     points: Vec<Vec3>,
 }
 
+/// What a frame slot's volume vertices were written from: every object's volumes, the groups,
+/// the objects' indices, the buffer's size (a grown buffer holds nothing yet).
+#[derive(Clone, Debug, PartialEq)]
+struct Written {
+    volumes: Vec<Option<VolumeKey>>,
+    groups: Vec<Vec<usize>>,
+    instances: Vec<u32>,
+    capacity: u64,
+}
+
 /// What a mesh's volumes need, found once: whether it takes the two-sided construction, and
 /// its nesting bound.
 #[derive(Clone, Copy, Debug)]
@@ -126,6 +154,8 @@ pub struct ShadowVolumes {
     accumulation: Accumulation,
     format: vk::Format,
     vertices: Option<PerFrame>,
+    /// Per frame slot: what its copy of `vertices` holds, and its ranges.
+    written: [Option<(Written, Vec<GroupRange>)>; FRAMES_IN_FLIGHT],
     depth_stencil: Option<Target>,
     /// Per scene object: its volumes, one per light point, and what they were built from.
     volumes: Vec<Option<(VolumeKey, Vec<ShadowVolume>)>>,
@@ -185,6 +215,7 @@ impl ShadowVolumes {
             accumulation,
             format,
             vertices: None,
+            written: Default::default(),
             depth_stencil: None,
             volumes: Vec::new(),
             facts: Vec::new(),
@@ -192,13 +223,21 @@ impl ShadowVolumes {
         })
     }
 
+    /// The mesh `o` casts its volumes from: the simplified shadow mesh where
+    /// `shadow_mesh_error` asks for it and `o` receives no shadow, else its own. A receiving
+    /// caster keeps its own: the volume's light caps must lie on the drawn surface (the counts
+    /// start there, no bias), and a simplified cap standing over the surface would put the
+    /// caster's own lit side inside its volume.
+    fn volume_mesh(o: &Object, light: Vec3, params: &Params) -> Arc<Mesh> {
+        if o.receives { o.mesh.clone() } else { shadow_mesh(o, light, params) }
+    }
+
     /// What every caster's mesh needs, found the first time it is seen.
-    fn learn_meshes(&mut self, frame: &FrameInputs<'_>) {
-        for o in frame.scene.objects.iter().filter(|o| o.casts) {
-            if self.facts.iter().any(|(id, _)| *id == o.mesh.id()) {
+    fn learn_meshes(&mut self, meshes: &[Option<Arc<Mesh>>]) {
+        for m in meshes.iter().flatten() {
+            if self.facts.iter().any(|(id, _)| *id == m.id()) {
                 continue;
             }
-            let m = &o.mesh;
             let caster = Caster { positions: &m.positions, triangles: &m.triangles, adjacency: &m.adjacency };
             let two_sided = is_open(&caster);
             self.facts.push((m.id(), MeshFacts { two_sided, bound: nesting_bound(&caster, two_sided) }));
@@ -210,35 +249,37 @@ impl ShadowVolumes {
     }
 
     /// Every caster's volumes from every point, rebuilt only for casters or lights that moved.
-    fn build(&mut self, frame: &FrameInputs<'_>, points: &[Vec3]) {
+    fn build(&mut self, frame: &FrameInputs<'_>, meshes: &[Option<Arc<Mesh>>], points: &[Vec3]) {
         let objects = &frame.scene.objects;
         self.volumes.resize_with(objects.len(), || None);
         let facts = &self.facts;
-        for (o, cached) in objects.iter().zip(&mut self.volumes) {
-            if !o.casts {
+        for ((o, m), cached) in objects.iter().zip(meshes).zip(&mut self.volumes) {
+            let Some(m) = m else {
                 *cached = None;
                 continue;
-            }
+            };
             let model = o.transform.matrix();
-            let key = VolumeKey { mesh: o.mesh.id(), model, points: points.to_vec() };
+            let key = VolumeKey { mesh: m.id(), model, points: points.to_vec() };
             if cached.as_ref().is_some_and(|(k, _)| *k == key) {
                 continue;
             }
-            let positions: Vec<Vec3> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
-            let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            let two_sided = facts.iter().any(|(id, f)| *id == o.mesh.id() && f.two_sided);
+            // Facing from the face planes built with the mesh against each point taken into
+            // object space: the volumes are vertex numbers, drawn from the object-space
+            // positions, so a moved caster transforms no vertex here.
+            let caster = Caster { positions: &m.positions, triangles: &m.triangles, adjacency: &m.adjacency };
+            let two_sided = facts.iter().any(|(id, f)| *id == m.id() && f.two_sided);
             let volumes =
-                points.iter().map(|q| shadow_volume(&caster, &light_facing(&caster, *q), two_sided)).collect();
+                points.iter().map(|q| shadow_volume(&caster, &m.planes.light_facing(&model, *q), two_sided)).collect();
             *cached = Some((key, volumes));
         }
     }
 
     /// Casters in groups whose nesting bounds sum to at most [`COUNT_MASK`].
-    fn groups(&self, frame: &FrameInputs<'_>) -> Vec<Vec<usize>> {
+    fn groups(&self, meshes: &[Option<Arc<Mesh>>]) -> Vec<Vec<usize>> {
         let mut groups: Vec<Vec<usize>> = Vec::new();
         let mut room = 0;
-        for (i, o) in frame.scene.objects.iter().enumerate().filter(|(_, o)| o.casts) {
-            let bound = self.facts_of(o.mesh.id()).bound.min(COUNT_MASK);
+        for (i, m) in meshes.iter().enumerate().filter_map(|(i, m)| Some((i, m.as_ref()?))) {
+            let bound = self.facts_of(m.id()).bound.min(COUNT_MASK);
             if groups.is_empty() || bound > room {
                 groups.push(Vec::new());
                 room = COUNT_MASK;
@@ -250,8 +291,18 @@ impl ShadowVolumes {
     }
 
     /// The volume vertices of every point and group, and each one's ranges.
-    fn vertices(&self, frame: &FrameInputs<'_>, points: usize, groups: &[Vec<usize>]) -> (Vec<f32>, Vec<GroupRange>) {
-        let mut out = Vec::new();
+    fn vertices(
+        &self,
+        frame: &FrameInputs<'_>,
+        meshes: &[Option<Arc<Mesh>>],
+        points: usize,
+        groups: &[Vec<usize>],
+    ) -> (Vec<f32>, Vec<GroupRange>) {
+        let triangles: usize = (self.volumes.iter().flatten())
+            .flat_map(|(_, v)| v)
+            .map(|v| v.sides.len() + v.far_caps.len() + v.near_caps.len() + v.turned_caps.len())
+            .sum();
+        let mut out = Vec::with_capacity(3 * VERTEX_FLOATS * triangles);
         let mut ranges = Vec::with_capacity(points * groups.len());
         for p in 0..points {
             for group in groups {
@@ -260,7 +311,7 @@ impl ShadowVolumes {
                 for (part, count) in counts.iter_mut().enumerate() {
                     let start = out.len();
                     for &i in group {
-                        let mesh = &frame.scene.objects[i].mesh;
+                        let mesh = meshes[i].as_ref().expect("a caster");
                         let object = frame.draws[i].instance as f32;
                         let volume = &self.volumes[i].as_ref().expect("built for every caster").1[p];
                         let mut put = |vertex: u32, far: bool| {
@@ -320,14 +371,26 @@ impl Technique for ShadowVolumes {
         let points: Vec<Vec3> = samples.iter().map(|s| s.position).collect();
         let z_fail = Self::z_fail(frame, params, &points);
         let reach = Self::extrusion(frame, &points).unwrap_or(0.0);
-        self.learn_meshes(frame);
-        let groups = self.groups(frame);
+        // One shadow mesh per caster for every point: the one for the light's centre, which the
+        // error's texels are stated from.
+        let light = frame.scene.light.position;
+        let meshes: Vec<Option<Arc<Mesh>>> =
+            frame.scene.objects.iter().map(|o| o.casts.then(|| Self::volume_mesh(o, light, params))).collect();
+        self.learn_meshes(&meshes);
+        let groups = self.groups(&meshes);
         let on_gpu = params.is_on(&GPU_SILHOUETTES);
         // The CPU path's ranges; the GPU path's are its draw commands.
         let ranges = if on_gpu {
-            let sided: Vec<Vec<(usize, bool)>> = groups
+            let sided: Vec<Vec<(usize, &Mesh, bool)>> = groups
                 .iter()
-                .map(|g| g.iter().map(|&i| (i, self.facts_of(frame.scene.objects[i].mesh.id()).two_sided)).collect())
+                .map(|g| {
+                    g.iter()
+                        .map(|&i| {
+                            let m = meshes[i].as_deref().expect("a caster");
+                            (i, m, self.facts_of(m.id()).two_sided)
+                        })
+                        .collect()
+                })
                 .collect();
             let gpu = match &mut self.gpu {
                 Some(gpu) => gpu,
@@ -337,14 +400,29 @@ impl Technique for ShadowVolumes {
             Vec::new()
         } else {
             let start = Instant::now();
-            self.build(frame, &points);
-            let (vertices, ranges) = self.vertices(frame, points.len(), &groups);
-            if !vertices.is_empty() {
-                let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-                let bytes: &[u8] = cast_slice(&vertices);
-                PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
-                    .write(frame.slot, bytes);
-            }
+            self.build(frame, &meshes, &points);
+            // The slot's vertices are written again only when what they hold changed.
+            let mut written = Written {
+                volumes: self.volumes.iter().map(|v| v.as_ref().map(|(k, _)| k.clone())).collect(),
+                groups: groups.clone(),
+                instances: frame.draws.iter().map(|d| d.instance).collect(),
+                capacity: self.vertices.as_ref().map_or(0, PerFrame::capacity),
+            };
+            let ranges = match &self.written[frame.slot] {
+                Some((w, ranges)) if *w == written => ranges.clone(),
+                _ => {
+                    let (vertices, ranges) = self.vertices(frame, &meshes, points.len(), &groups);
+                    if !vertices.is_empty() {
+                        let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+                        let bytes: &[u8] = cast_slice(&vertices);
+                        PerFrame::ensure(ctx, &mut self.vertices, "shadow volumes", bytes.len() as u64, usage)?
+                            .write(frame.slot, bytes);
+                    }
+                    written.capacity = self.vertices.as_ref().map_or(0, PerFrame::capacity);
+                    self.written[frame.slot] = Some((written, ranges.clone()));
+                    ranges
+                }
+            };
             frame.cpu_spans.push(("silhouettes", start.elapsed().as_secs_f64() * 1e3));
             ranges
         };
@@ -373,7 +451,7 @@ impl Technique for ShadowVolumes {
         let caps = z_fail || reach > 0.0;
         span(frame, !timed, "accumulate");
         for p in 0..points.len() {
-            if let Some(gpu) = self.gpu.as_ref().filter(|_| on_gpu) {
+            if let Some(gpu) = self.gpu.as_ref().filter(|g| on_gpu && g.building()) {
                 span(frame, timed, "silhouettes");
                 gpu.record(frame, p)?;
                 end_span(frame, timed);

@@ -281,7 +281,7 @@ impl Technique for Smoothie {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }
             let gpu = self.gpu.as_mut().expect("made above");
-            let (vertices, args) = gpu.record(frame, &frustum.view, (smoothie_size, frustum.far), centred)?;
+            let (vertices, args) = gpu.record(frame, params, &frustum.view, (smoothie_size, frustum.far), centred)?;
             Smoothies::Indirect { vertices, args }
         } else {
             let geometry = self.geometry(frame, params, &frustum.view, (smoothie_size, frustum.far), centred);

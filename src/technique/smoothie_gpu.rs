@@ -11,6 +11,8 @@ use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec4};
 
+use super::knobs::Params;
+use super::shadow_mesh::shadow_caster;
 use super::smoothie::penumbra;
 use crate::error::Result;
 use crate::frame::FrameInputs;
@@ -113,17 +115,22 @@ impl GpuSilhouettes {
         })
     }
 
-    /// Records the silhouette dispatches of every caster seen through `view`; returns the
-    /// vertex buffer and the indirect draw arguments the smoothie pass draws from.
+    /// Records the silhouette dispatches of every caster (its shadow mesh, by `knobs`) seen
+    /// through `view`; returns the vertex buffer and the indirect draw arguments the smoothie
+    /// pass draws from.
     pub fn record(
         &mut self,
         frame: &mut FrameInputs<'_>,
+        knobs: &Params,
         view: &Mat4,
         (size, far): (SmoothieSize, f32),
         centred: bool,
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
-        let casters: Vec<_> = frame.scene.objects.iter().filter(|o| o.casts).collect();
+        // The simplified shadow meshes where `shadow_mesh_error` asks for them, as the CPU path.
+        let light = frame.scene.light.position;
+        let casters: Vec<_> =
+            frame.scene.objects.iter().filter(|o| o.casts).map(|o| shadow_caster(o, light, knobs)).collect();
         let cmd = frame.cmd;
         let meshes = casters
             .iter()

@@ -217,3 +217,28 @@ pub fn error_minimising_scale(
     let best = (0..scales.len()).min_by(|&a, &b| errors[a].total_cmp(&errors[b])).unwrap();
     scales[best]
 }
+
+/// Names of the GPU passes of every frame rendered since the last call.
+pub fn passes_per_frame(e: &mut Engine) -> Vec<Vec<&'static str>> {
+    e.flush().unwrap();
+    e.take_timings().iter().map(|t| t.passes.iter().map(|p| p.name).collect()).collect()
+}
+
+/// `technique` with its silhouettes on the GPU (`gpu_silhouettes = 1`) drawing `s` at 64², five
+/// frames with nothing changed: the settings, the first and last captures, each frame's passes.
+pub fn static_compute_frames(
+    e: &mut Engine,
+    s: &Scene,
+    technique: &str,
+) -> (FrameSettings, Capture, Capture, Vec<Vec<&'static str>>) {
+    let mut frame = settings(s, 64, 64);
+    frame.params = Params::defaults(find(technique).expect("a known technique"));
+    frame.params.set("gpu_silhouettes", "1").expect("a compute path");
+    let first = e.render_and_capture(s, &frame).expect("a rendered frame");
+    for _ in 0..3 {
+        e.render(s, &frame).expect("a rendered frame");
+    }
+    let last = e.render_and_capture(s, &frame).expect("a rendered frame");
+    let passes = passes_per_frame(e);
+    (frame, first, last, passes)
+}
