@@ -29,8 +29,8 @@ pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, Variants, VertexInput};
 pub use reflect::Binding;
 pub use render::{
-    Attachment, RenderPass, dispatch, draw_fullscreen, draw_indexed, draw_indirect, draw_vertices, fullscreen,
-    update_buffer,
+    Attachment, RenderPass, dispatch, draw_fullscreen, draw_generated, draw_indexed, draw_indirect, draw_vertices,
+    fullscreen, update_buffer,
 };
 pub use swapchain::{Acquired, NativeWindow, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
