@@ -29,8 +29,10 @@ const ABOVE_LIGHT: f32 = 1e-4;
 /// Steepest angle from the plane's normal a base ellipse follows (85°): towards the horizon the
 /// true footprint grows without bound (a parabola, then a hyperbola).
 const MAX_TILT_TAN: f32 = 11.43;
-/// Bisection steps of the outer tangent: f32 resolution of s = tan(δ/2) ∈ [−1, 1].
+/// Most steps of the outer tangent's root search (bisection's for f32 resolution of s =
+/// tan(δ/2) ∈ [−1, 1]), and the bracket width at which it stops.
 const TANGENT_STEPS: u32 = 26;
+const TANGENT_TOLERANCE: f32 = 1e-6;
 
 /// A receiver plane with an in-plane frame: height along `normal`, coordinates along `u`, `v`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -146,8 +148,29 @@ impl Cone {
         // The exit point x = s·q − w with |x| = 1, s > 0.
         let (qq, qw, ww) = (q.length_squared(), q.dot(w), w.length_squared());
         let x = q * ((qw + (qw * qw - qq * (ww - 1.0)).max(0.0).sqrt()) / qq) - w;
-        x.y.atan2(x.x)
+        atan2(x.y, x.x)
     }
+}
+
+/// atan2 within 1e-5 rad, plenty beside the wedges' overlap of [`WEDGE_OVERLAP`]: the rim
+/// angles of every corner are a moving frame's only angles (issue 18: libm's atan2 took a
+/// sixth of its CPU time). The odd polynomial of atan on [0, 1] of Abramowitz & Stegun 4.4.49
+/// (error 2e-8), then the octant.
+fn atan2(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let (z, z2) = (lo / hi, (lo / hi) * (lo / hi));
+    let a = [0.021_861_23, -0.055_909_89, 0.096_420_04, -0.139_085_34, 0.199_465_36, -0.333_298_56, 0.999_999_33]
+        .into_iter()
+        .fold(-0.004_054_058f32, |p, c| p * z2 + c)
+        * z;
+    let a = if ay > ax { FRAC_PI_2 - a } else { a };
+    let a = if x < 0.0 { PI - a } else { a };
+    if y < 0.0 { -a } else { a }
 }
 
 /// The cone of vertex `p` under a light sphere (`light`, `radius`); `None` when `p` casts
@@ -203,16 +226,34 @@ pub fn outer_tangent(a: &Cone, b: &Cone, outward: Vec2) -> Option<(Vec2, Vec2)> 
     // factor: ν ∝ side·(1 − s²) + along·2s with s = tan(δ/2) ∈ [−1, 1], free of trigonometry.
     let nu = |s: f32| side * (1.0 - s * s) + along * (2.0 * s);
     let g = |s: f32| b.support(nu(s)) - a.support(nu(s));
-    let (mut lo, mut hi) = (-1.0f32, 1.0f32);
-    if !(g(lo) < 0.0 && g(hi) > 0.0) {
+    if !(g(-1.0) < 0.0 && g(1.0) > 0.0) {
         return None;
     }
+    // Newton's method from s = 0 (the tangent of equal bases), kept inside the bracket that the
+    // signs of g give (bisecting where a step would leave it): g = ν·(p_b − p_a) with p the
+    // bases' support points for ν, and, the support function's gradient being its support
+    // point, g' = ν'·(p_b − p_a), so one pair of support points a step. Issue 18: the 26
+    // bisection steps were most of a moving frame's CPU time; this takes a few.
+    let (mut lo, mut hi, mut s) = (-1.0f32, 1.0f32, 0.0f32);
+    let mut touch = (a.centre, b.centre);
     for _ in 0..TANGENT_STEPS {
-        let mid = 0.5 * (lo + hi);
-        if g(mid) < 0.0 { lo = mid } else { hi = mid }
+        let n = nu(s);
+        touch = (a.support_point(n), b.support_point(n));
+        let gap = touch.1 - touch.0;
+        let at = n.dot(gap);
+        match at.partial_cmp(&0.0) {
+            Some(std::cmp::Ordering::Less) => lo = s,
+            Some(std::cmp::Ordering::Greater) => hi = s,
+            _ => break,
+        }
+        let step = at / (along * 2.0 - side * (2.0 * s)).dot(gap);
+        let next = if s - step > lo && s - step < hi { s - step } else { 0.5 * (lo + hi) };
+        if (next - s).abs() <= TANGENT_TOLERANCE {
+            break;
+        }
+        s = next;
     }
-    let n = nu(0.5 * (lo + hi));
-    Some((a.support_point(n), b.support_point(n)))
+    Some(touch)
 }
 
 /// A sheet (§2) as one primitive: the bilinear patch P(s, t) = lerp(lerp(a, b, s), lerp(ta, tb,
@@ -265,9 +306,10 @@ impl Sheet {
     /// The plateau parameter at `p` and the hard edge's parameter s of its foot: the smallest t
     /// of the patch over `p` (where it folds over itself two cover it; min blending of the
     /// tessellation kept the smaller), `None` off the patch. What `glsl/plateau/penumbra.frag`
-    /// computes per fragment: with e = b − a, f = ta − a, g = tb − ta − e and q = p − a, q = s·e
-    /// + t·f + s·t·g; crossing with e + t·g removes s: (f × g)·t² + (f × e − q × g)·t − q × e = 0,
-    /// solved in the form without cancellation for either root.
+    /// computes per fragment: with e = b − a, f = ta − a, g = tb − ta − e and q = p − a,
+    /// q = s·e + t·f + s·t·g; crossing with e + t·g removes s, leaving
+    /// (f × g)·t² + (f × e − q × g)·t − q × e = 0, solved in the form without cancellation for
+    /// either root.
     pub fn at(&self, p: Vec2) -> Option<(f32, f32)> {
         let [a, b, tb, ta] = self.corners();
         let (e, f, q) = (b - a, ta - a, p - a);
@@ -297,11 +339,15 @@ impl Sheet {
 /// The convex hull of a quadrilateral's corners as two triangles of corner numbers, anticlockwise
 /// (a triangular hull: the second degenerate). Andrew's monotone chain on four points.
 fn hull_triangles(p: [Vec2; 4]) -> [u32; 6] {
+    // Sorted by x, then y, with the five exchanges of a sorting network (a sort call with its
+    // comparison closure cost more than the rest of a sheet).
     let mut order = [0u32, 1, 2, 3];
-    order.sort_unstable_by(|&i, &j| {
-        let (a, b) = (p[i as usize], p[j as usize]);
-        a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y))
-    });
+    for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+        let (a, b) = (p[order[i] as usize], p[order[j] as usize]);
+        if b.x < a.x || b.x == a.x && b.y < a.y {
+            order.swap(i, j);
+        }
+    }
     let turn = |o: u32, a: u32, b: u32| (p[a as usize] - p[o as usize]).perp_dot(p[b as usize] - p[o as usize]);
     let mut hull = [0u32; 8];
     let mut n = 0;
@@ -361,9 +407,9 @@ impl Wedge {
         unit.map(|x| apex + axes * (x + lean))
     }
 
-    /// The cone's t at `p` (beyond 1 off the base): from y = axes⁻¹·(p − apex), (1 − |lean|²)·t²
-    /// + 2·(y·lean)·t − |y|² = 0, whose positive root is taken in the form without cancellation
-    /// (the apex lies inside the base: |lean| < 1).
+    /// The cone's t at `p` (beyond 1 off the base): with y = axes⁻¹·(p − apex), the positive
+    /// root of (1 − |lean|²)·t² + 2·(y·lean)·t − |y|² = 0, in the form without cancellation (the
+    /// apex lies inside the base: |lean| < 1).
     pub fn t_at(&self, p: Vec2) -> f32 {
         let (y, lean) = (self.axes().inverse() * (p - Vec2::from(self.apex)), Vec2::from(self.lean));
         let (yy, yl) = (y.length_squared(), y.dot(lean));
@@ -407,6 +453,11 @@ impl PlateauGeometry {
             return;
         }
         let lean = cone.axes.inverse() * cone.offset;
+        // The base's bounding box, once per cone: what the pieces draw past the rim has t > 1
+        // and is discarded, so it need not fit in the texture.
+        let reach = Vec2::new(cone.axes.row(0).length(), cone.axes.row(1).length());
+        let base = cone.centre + cone.offset;
+        [cone.centre, base - reach, base + reach].into_iter().for_each(|p| self.grow(p));
         let pieces = ((to - from) / WEDGE_SPAN).ceil().max(1.0);
         let step = (to - from) / pieces;
         for k in 0..pieces as u32 {
@@ -420,7 +471,6 @@ impl PlateauGeometry {
                 caster,
                 pad: 0.0,
             };
-            wedge.outline().into_iter().for_each(|p| self.grow(p));
             self.cones.push(wedge);
         }
     }
@@ -794,6 +844,12 @@ mod tests {
             prop_assert!((wedge.t_at(p) - t).abs() < 1e-3 * scale, "t {} at {t} of the way", wedge.t_at(p));
             let beyond = cone.centre.lerp(rim, 1.2);
             prop_assert!(wedge.t_at(beyond) > 1.0 + 1e-3);
+        }
+
+        #[test]
+        fn the_rim_angles_atan2_is_libms_within_1e_5(angle in -std::f32::consts::PI..std::f32::consts::PI, r in 1e-3f32..1e3) {
+            let (y, x) = (r * angle.sin(), r * angle.cos());
+            prop_assert!((atan2(y, x) - y.atan2(x)).abs() < 1e-5, "{} vs {}", atan2(y, x), y.atan2(x));
         }
 
         #[test]
