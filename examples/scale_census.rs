@@ -9,16 +9,14 @@
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
-use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, PlateauVertex, ReceiverPlane, plateau_sides};
+use softshadow::geometry::plateau::{
+    self, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
+};
 use softshadow::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Scene;
 use softshadow::technique::shadow_mesh::texels_at_caster;
-
-/// What the plateau and smoothie use by default: centred penumbrae of the physical size, the
-/// plateau's cone segments and 1024² targets.
-const CONE_SEGMENTS: u32 = 32;
 
 /// Summed triangle area of a triangle list of 2D points.
 fn area(points: impl Iterator<Item = Vec2>) -> f64 {
@@ -39,13 +37,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         radius: scene.light.radius,
         size: PenumbraSize::Physical { scale: 1.0 },
         penumbra: plateau::Penumbra::Centred,
-        cone_segments: CONE_SEGMENTS,
         wedges: true,
     };
     let h = ground.half_size;
     let receivers = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, z)| Vec3::new(x, ground.height, z));
     println!(
-        "| caster | triangles | edges | boundary | silhouette edges | CPU ms: transform, facing+edges, plateau sides, smoothies | cone tris | sheet tris | plateau fragments (1024²) | smoothie edge tris | corner tris | smoothie fragments |"
+        "| caster | triangles | edges | boundary | silhouette edges | CPU ms: transform, facing+edges, plateau sides, smoothies | wedges | sheets | plateau fragments (1024²) | smoothie edge tris | corner tris | smoothie fragments |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for o in scene.objects.iter().filter(|o| o.casts) {
@@ -56,33 +53,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let transform_ms = started.elapsed().as_secs_f64() * 1e3;
         let caster = Caster { positions: &positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
         let source = if mesh.adjacency.is_closed() { EdgeSource::Silhouettes } else { EdgeSource::LightFacing };
+        let object = Caster { positions: &mesh.positions, ..caster };
         let started = Instant::now();
         let facing = mesh.planes.light_facing(&model, light);
-        let edges = penumbra_edges(&caster, &facing, source);
+        let edges = plateau_edges(&object, &facing, source);
         let edges_ms = started.elapsed().as_secs_f64() * 1e3;
         let closed_edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
 
         let started = Instant::now();
-        let sides = plateau_sides(&plane, &plateau_light, &caster, 0.0, source);
+        let sides = plateau_sides(&plane, &plateau_light, &object, &model, &edges, source, 0.0);
         let sides_ms = started.elapsed().as_secs_f64() * 1e3;
         let (lo, hi) = sides.footprint.unwrap_or((Vec2::ZERO, Vec2::ONE));
         let plateau_texel = (texels * texels) / f64::from((hi - lo).x * (hi - lo).y).max(1e-12);
-        let uv = |v: &PlateauVertex| Vec2::new(v.u, v.v);
-        let cone_fragments = area(sides.cones.iter().map(uv)) * plateau_texel;
-        let sheet_fragments = area(sides.sheets.iter().map(uv)) * plateau_texel;
+        // What the GPU draws: each wedge's three triangles, each sheet's hull.
+        let drawn = |g: &PlateauGeometry| {
+            let cones = area(g.cones.iter().flat_map(|w| w.outline())) * plateau_texel;
+            (cones, area(g.sheets.iter().flat_map(|s| s.hull_points())) * plateau_texel)
+        };
+        let (cone_fragments, sheet_fragments) = drawn(&sides);
 
         if source != EdgeSource::Silhouettes {
             // What the open mesh would cost if only the edges bounding its lit part had sides.
             let started = Instant::now();
-            let bounding = plateau_sides(&plane, &plateau_light, &caster, 0.0, EdgeSource::Silhouettes);
+            let bounding_edges = plateau_edges(&object, &facing, EdgeSource::Silhouettes);
+            let bounding =
+                plateau_sides(&plane, &plateau_light, &object, &model, &bounding_edges, EdgeSource::Silhouettes, 0.0);
             let ms = started.elapsed().as_secs_f64() * 1e3;
-            let fragments =
-                (area(bounding.cones.iter().map(uv)) + area(bounding.sheets.iter().map(uv))) * plateau_texel;
+            let (cones, sheets) = drawn(&bounding);
             println!(
-                "{}: with only the edges bounding the lit part (silhouettes and lit boundary edges): {} cone tris, {} sheet tris, {fragments:.0} fragments, {ms:.2} CPU ms",
+                "{}: with only the edges bounding the lit part (silhouettes and lit boundary edges): {} wedges, {} sheets, {:.0} fragments, {ms:.2} CPU ms",
                 o.name,
-                bounding.cones.len() / 3,
-                bounding.sheets.len() / 3
+                bounding.cones.len(),
+                bounding.sheets.len(),
+                cones + sheets
             );
         }
         for texels in [1.0, 4.0] {
@@ -121,8 +124,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mesh.adjacency.boundary,
             closed_edges.len(),
             edges.len(),
-            sides.cones.len() / 3,
-            sides.sheets.len() / 3,
+            sides.cones.len(),
+            sides.sheets.len(),
             cone_fragments,
             cone_fragments / (texels * texels),
             sheet_fragments,

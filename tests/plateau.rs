@@ -262,3 +262,83 @@ casts = false
     assert!(mapped.visibility_at(slab.0, slab.1) < 0.05, "{}", mapped.visibility_at(slab.0, slab.1));
     finish(e);
 }
+
+/// Issue 18: the plateau texture holds the exact t of its primitives. Outer only, linear falloff
+/// and whole cones, V on the ground is the texture's t; it must match a CPU evaluation of the
+/// whole cones and the exact bilinear patches (min over all, each evaluated everywhere, not only
+/// inside what the GPU draws of it), within 1/255, on a tilted box (twisted sheets) seen from
+/// above, away from the hard edge's texels and from the box itself.
+#[test]
+fn the_plateau_texture_holds_the_exact_t_of_whole_cones_and_patches() {
+    use glam::{Vec2, Vec3};
+    use softshadow::geometry::plateau::{
+        Penumbra, PenumbraSize, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
+    };
+    use softshadow::geometry::silhouette::{Caster, EdgeSource};
+    let (size, half) = (128u32, 1.6f32);
+    let objects = "[[object]]\nshape = \"box\"\nsize = [1.0, 0.1, 0.8]\nposition = [0.0, 1.2, 0.0]\nrotation_deg = [25.0, 0.0, 10.0]\n";
+    let s = top_down(0.0, half, [1.0, 6.0, 0.5], 1.0, objects);
+    let mut e = engine();
+    let c = render_with(&mut e, &s, "plateau", &[("penumbra", "0"), ("falloff", "0"), ("cones", "0")], size);
+    finish(e);
+
+    let o = &s.objects[0];
+    let (mesh, model) = (&o.mesh, o.transform.matrix());
+    let (plane, light) = (ReceiverPlane::ground(0.0), s.light.position);
+    let plateau_light = PlateauLight {
+        position: light,
+        radius: s.light.radius,
+        size: PenumbraSize::Physical { scale: 1.0 },
+        penumbra: Penumbra::Outer,
+        wedges: false,
+    };
+    let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+    let edges = plateau_edges(&caster, &mesh.planes.light_facing(&model, light), EdgeSource::Silhouettes);
+    let sides = plateau_sides(&plane, &plateau_light, &caster, &model, &edges, EdgeSource::Silhouettes, 1.0);
+    assert!(
+        sides.cones.len() >= 16 && sides.sheets.len() >= 6,
+        "{} wedges, {} sheets",
+        sides.cones.len(),
+        sides.sheets.len()
+    );
+    let exact = |p: Vec2| {
+        let cones = sides.cones.iter().map(|w| w.t_at(p));
+        let sheets = sides.sheets.iter().filter_map(|s| s.at(p).map(|(t, _)| t));
+        cones.chain(sheets).fold(1.0f32, f32::min)
+    };
+    // Triangles in the plane: projected from the light (the hard shadow), and straight down
+    // (what the camera sees of the box instead of the ground).
+    let triangles = |to: &dyn Fn(Vec3) -> Vec2| -> Vec<[Vec2; 3]> {
+        mesh.triangles.iter().map(|t| t.map(|v| to(model.transform_point3(mesh.positions[v as usize])))).collect()
+    };
+    let inside = |tris: &[[Vec2; 3]], p: Vec2| {
+        tris.iter().any(|t| {
+            let w = [0, 1, 2].map(|k| (t[(k + 1) % 3] - t[k]).perp_dot(p - t[k]));
+            w.iter().all(|w| *w >= 0.0) || w.iter().all(|w| *w <= 0.0)
+        })
+    };
+    let shadow = triangles(&|p| plane.project(light, p).unwrap());
+    let box_seen = triangles(&|p| Vec2::new(p.x, p.z));
+    let pixel = 2.0 * half / size as f32;
+    // Image x is world x, rows world z, from −half.
+    let ground = |x: f32, y: f32| Vec2::new(-half + (x + 0.5) * pixel, -half + (y + 0.5) * pixel);
+    let (mut worst, mut compared, mut penumbra) = (0.0f32, 0, 0);
+    for y in 0..size {
+        for x in 0..size {
+            let p = ground(x as f32, y as f32);
+            // Two pixels off the hard edge and the box's outline: the texture's bilinear
+            // lookup there mixes in the mask's t = 0.
+            let near = [(-2.0, 0.0), (2.0, 0.0), (0.0, -2.0), (0.0, 2.0), (0.0, 0.0)]
+                .map(|(dx, dy)| p + Vec2::new(dx, dy) * pixel);
+            if near.iter().any(|q| inside(&shadow, *q) || inside(&box_seen, *q)) {
+                continue;
+            }
+            let (got, want) = (c.visibility_at(x, y), exact(p));
+            worst = worst.max((got - want).abs());
+            compared += 1;
+            penumbra += (want < 0.99) as u32;
+        }
+    }
+    assert!(penumbra > 500 && compared > penumbra, "{penumbra} penumbra pixels of {compared}");
+    assert!(worst <= 1.0 / 255.0, "V differs from the exact t by up to {worst} ({penumbra} penumbra pixels)");
+}

@@ -1,8 +1,8 @@
 #version 460
-// The plateau's sides write t, blended by min (the darkest wins, Haines §2), into channel r; g
-// stays 1. Centred (issue 20), t is the distance to the hard shadow's boundary in half widths on
-// both of its sides, so only silhouettes on that boundary may write it: the mask must be lit a
-// couple of texels off the foot, across the edge (either way: an edge seen edge-on has no
+// The plateau's sides write t, blended by min (the darkest wins, Haines §2), into channel r
+// (outer only; g stays 1). Centred (issue 20), t is the distance to the hard shadow's boundary
+// in half widths on both of its sides, so only silhouettes on that boundary may write it: the
+// mask must be lit a couple of texels off the foot, across the edge (either way: an edge seen edge-on has no
 // reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
 // has shadow on both sides and writes nothing, so no bright streak crosses the umbra.
 //
@@ -18,18 +18,66 @@ layout(constant_id = 0) const bool CENTRED = false;
 // More than one caster: the mask may hold another caster's number where a side is drawn. With
 // one, it holds only this caster's or none, and the texel under the fragment need not be read.
 layout(constant_id = 1) const bool OVERLAPS = true;
+// Sheets or wedges (see penumbra.vert for what each interpolates).
+layout(constant_id = 2) const bool SHEETS = false;
 
 layout(set = 0, binding = 1) uniform sampler2D mask;
 
-layout(location = 0) in float in_t;
+layout(location = 0) in vec2 in_local;
 layout(location = 1) in vec2 in_uv;
-layout(location = 2) in vec2 in_foot;
-layout(location = 3) flat in vec2 in_normal;
-layout(location = 4) flat in uint in_caster;
+layout(location = 2) flat in vec4 in_shape0;
+layout(location = 3) flat in vec4 in_shape1;
+layout(location = 4) flat in vec2 in_edge;
+layout(location = 5) flat in vec2 in_normal;
+layout(location = 6) flat in uint in_caster;
 layout(location = 0) out vec2 out_t;
 
 // How far off the foot the mask is probed, in texels: past the hard edge's rasterisation.
 const float PROBE = 2.0;
+
+float cross2(vec2 a, vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
+
+// Slack of s and t at a sheet's sides (f32 rounding), as geometry::plateau::Sheet::at.
+const float SHEET_SLACK = 1e-4;
+
+// A sheet's smallest t over this fragment and its foot's s on the hard edge: the inverse of the
+// bilinear map q = s·e + t·f + s·t·g (q = p − a), whose t solves (f × g)·t² + (f × e − q × g)·t −
+// q × e = 0, in the form without cancellation (Sheet::at). False off the patch.
+bool sheet_t(out float t, out float s) {
+    vec2 e = in_shape0.xy, f = in_shape0.zw, q = in_local;
+    vec2 g = in_shape1.xy - f - e;
+    float qa = cross2(f, g), qb = cross2(f, e) - cross2(q, g), qc = -cross2(q, e);
+    float d = qb * qb - 4.0 * qa * qc;
+    if (d < 0.0) {
+        return false;
+    }
+    float h = -0.5 * (qb + (qb < 0.0 ? -sqrt(d) : sqrt(d)));
+    float roots[2] = float[2](h != 0.0 ? qc / h : -1.0, qa != 0.0 ? h / qa : -1.0);
+    t = 2.0;
+    for (int k = 0; k < 2; k++) {
+        float r = roots[k];
+        if (r < -SHEET_SLACK || r > 1.0 || r >= t) {
+            continue;
+        }
+        vec2 side = e + g * r;
+        float u = dot(q - f * r, side) / dot(side, side);
+        if (u >= -SHEET_SLACK && u <= 1.0 + SHEET_SLACK) {
+            t = r;
+            s = clamp(u, 0.0, 1.0);
+        }
+    }
+    t = max(t, 0.0);
+    return t <= 1.0;
+}
+
+// A cone's t at y (unit-disk coordinates from the apex): the positive root of (1 − |lean|²)·t² +
+// 2·(y·lean)·t − |y|² = 0 (Wedge::t_at).
+float wedge_t(vec2 y, vec2 lean) {
+    float yy = dot(y, y), yl = dot(y, lean);
+    return yy == 0.0 ? 0.0 : yy / (yl + sqrt(yl * yl + (1.0 - dot(lean, lean)) * yy));
+}
 
 uint caster_at(vec2 texel) {
     ivec2 size = textureSize(mask, 0);
@@ -43,12 +91,24 @@ vec2 in_channel(uint caster, float t) {
 }
 
 void main() {
-    out_t = vec2(in_t, 1.0);
+    float t, s = 0.0;
+    if (SHEETS) {
+        if (!sheet_t(t, s)) {
+            discard;
+        }
+    } else {
+        t = wedge_t(in_local, in_shape0.xy);
+        if (t > 1.0) {
+            discard; // off the base: t = 1 (lit) is what the texture holds there
+        }
+    }
+    out_t = vec2(t, 1.0);
     if (!CENTRED) {
         return;
     }
     vec2 size = vec2(textureSize(mask, 0));
-    vec2 foot = in_foot * size;
+    // The foot: on a sheet's hard edge, a cone's apex.
+    vec2 foot = (in_shape1.zw + s * in_edge) * size;
     vec2 from_foot = in_uv * size - foot;
     // A cone's normal at this pixel is the direction from its apex.
     vec2 across = in_normal != vec2(0.0) ? in_normal * size : from_foot;
@@ -62,7 +122,7 @@ void main() {
         if (caster_at(foot + probe) != 0u && caster_at(foot - probe) != 0u) {
             discard;
         }
-        out_t = in_channel(in_caster, in_t);
+        out_t = in_channel(in_caster, t);
         return;
     }
     uint a = caster_at(foot + probe), b = caster_at(foot - probe);
@@ -72,5 +132,5 @@ void main() {
     if (!outer_half || (a == in_caster && b == in_caster)) {
         discard;
     }
-    out_t = in_channel(here + 1u, in_t);
+    out_t = in_channel(here + 1u, t);
 }

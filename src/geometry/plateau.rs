@@ -20,7 +20,7 @@ use std::f32::consts::TAU;
 
 use rayon::prelude::*;
 
-use super::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
+use super::silhouette::{Caster, EdgeSource, Facing, penumbra_edges};
 
 /// Fraction of the light's height above which a point casts nothing: its projection from the
 /// light would land behind the light (an anti-shadow). Such vertices get no cones or sheets,
@@ -29,8 +29,10 @@ const ABOVE_LIGHT: f32 = 1e-4;
 /// Steepest angle from the plane's normal a base ellipse follows (85°): towards the horizon the
 /// true footprint grows without bound (a parabola, then a hyperbola).
 const MAX_TILT_TAN: f32 = 11.43;
-/// Bisection steps of the outer tangent: f32 resolution of s = tan(δ/2) ∈ [−1, 1].
+/// Most steps of the outer tangent's root search (bisection's for f32 resolution of s =
+/// tan(δ/2) ∈ [−1, 1]), and the bracket width at which it stops.
 const TANGENT_STEPS: u32 = 26;
+const TANGENT_TOLERANCE: f32 = 1e-6;
 
 /// A receiver plane with an in-plane frame: height along `normal`, coordinates along `u`, `v`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,12 +139,6 @@ impl Cone {
         self.axes.col(0).length_squared() == 0.0 && self.axes.col(1).length_squared() == 0.0
     }
 
-    /// The base's rim at angle φ: centre + offset + axes·(cos φ, sin φ).
-    fn rim(&self, angle: f32) -> Vec2 {
-        let (sin, cos) = angle.sin_cos();
-        self.centre + self.offset + self.axes * Vec2::new(cos, sin)
-    }
-
     /// The rim angle where the ray from the apex along `d` leaves the base; `inverse`: the
     /// axes' inverse. The apex lies inside the base (the ray through the light's centre is in
     /// the cone), so the angle turns with `d`, and the same way round: the axes keep their
@@ -152,8 +148,29 @@ impl Cone {
         // The exit point x = s·q − w with |x| = 1, s > 0.
         let (qq, qw, ww) = (q.length_squared(), q.dot(w), w.length_squared());
         let x = q * ((qw + (qw * qw - qq * (ww - 1.0)).max(0.0).sqrt()) / qq) - w;
-        x.y.atan2(x.x)
+        atan2(x.y, x.x)
     }
+}
+
+/// atan2 within 1e-5 rad, plenty beside the wedges' overlap of [`WEDGE_OVERLAP`]: the rim
+/// angles of every corner are a moving frame's only angles (issue 18: libm's atan2 took a
+/// sixth of its CPU time). The odd polynomial of atan on [0, 1] of Abramowitz & Stegun 4.4.49
+/// (error 2e-8), then the octant.
+fn atan2(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (lo, hi) = (ax.min(ay), ax.max(ay));
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let (z, z2) = (lo / hi, (lo / hi) * (lo / hi));
+    let a = [0.021_861_23, -0.055_909_89, 0.096_420_04, -0.139_085_34, 0.199_465_36, -0.333_298_56, 0.999_999_33]
+        .into_iter()
+        .fold(-0.004_054_058f32, |p, c| p * z2 + c)
+        * z;
+    let a = if ay > ax { FRAC_PI_2 - a } else { a };
+    let a = if x < 0.0 { PI - a } else { a };
+    if y < 0.0 { -a } else { a }
 }
 
 /// The cone of vertex `p` under a light sphere (`light`, `radius`); `None` when `p` casts
@@ -209,56 +226,204 @@ pub fn outer_tangent(a: &Cone, b: &Cone, outward: Vec2) -> Option<(Vec2, Vec2)> 
     // factor: ν ∝ side·(1 − s²) + along·2s with s = tan(δ/2) ∈ [−1, 1], free of trigonometry.
     let nu = |s: f32| side * (1.0 - s * s) + along * (2.0 * s);
     let g = |s: f32| b.support(nu(s)) - a.support(nu(s));
-    let (mut lo, mut hi) = (-1.0f32, 1.0f32);
-    if !(g(lo) < 0.0 && g(hi) > 0.0) {
+    if !(g(-1.0) < 0.0 && g(1.0) > 0.0) {
         return None;
     }
+    // Newton's method from s = 0 (the tangent of equal bases), kept inside the bracket that the
+    // signs of g give (bisecting where a step would leave it): g = ν·(p_b − p_a) with p the
+    // bases' support points for ν, and, the support function's gradient being its support
+    // point, g' = ν'·(p_b − p_a), so one pair of support points a step. Issue 18: the 26
+    // bisection steps were most of a moving frame's CPU time; this takes a few.
+    let (mut lo, mut hi, mut s) = (-1.0f32, 1.0f32, 0.0f32);
+    let mut touch = (a.centre, b.centre);
     for _ in 0..TANGENT_STEPS {
-        let mid = 0.5 * (lo + hi);
-        if g(mid) < 0.0 { lo = mid } else { hi = mid }
+        let n = nu(s);
+        touch = (a.support_point(n), b.support_point(n));
+        let gap = touch.1 - touch.0;
+        let at = n.dot(gap);
+        match at.partial_cmp(&0.0) {
+            Some(std::cmp::Ordering::Less) => lo = s,
+            Some(std::cmp::Ordering::Greater) => hi = s,
+            _ => break,
+        }
+        let step = at / (along * 2.0 - side * (2.0 * s)).dot(gap);
+        let next = if s - step > lo && s - step < hi { s - step } else { 0.5 * (lo + hi) };
+        if (next - s).abs() <= TANGENT_TOLERANCE {
+            break;
+        }
+        s = next;
     }
-    let n = nu(0.5 * (lo + hi));
-    Some((a.support_point(n), b.support_point(n)))
+    Some(touch)
 }
 
-/// A plateau vertex: plane coordinates, the plateau parameter t (0 dark, 1 lit), the point of
-/// the silhouette it is measured from (a cone's apex, the sheet's hard edge), the edge's unit
-/// normal in the plane (zero on cones: there the direction to the vertex is the normal) and
-/// the caster's number, as the umbra mask writes it.
+/// A sheet (§2) as one primitive: the bilinear patch P(s, t) = lerp(lerp(a, b, s), lerp(ta, tb,
+/// s), t) between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1), the Coons
+/// patch of four lines the paper tessellates (Figure 4, §3). Drawn as its corners' convex hull
+/// (the patch, a convex combination of its corners, lies inside it); the GPU finds t per
+/// fragment by inverting the map ([`Sheet::at`]), exact where the tessellation was within 1%.
+/// Also the edge's unit normal in the plane and the caster's number, as the umbra mask writes it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct PlateauVertex {
-    pub u: f32,
-    pub v: f32,
-    pub t: f32,
-    pub foot: [f32; 2],
+pub struct Sheet {
+    pub a: [f32; 2],
+    pub b: [f32; 2],
+    pub ta: [f32; 2],
+    pub tb: [f32; 2],
     pub normal: [f32; 2],
     pub caster: f32,
+    /// The hull as two triangles: six corner numbers of 2 bits, the first lowest (0 a, 1 b,
+    /// 2 tb, 3 ta; a triangular hull repeats a corner).
+    pub hull: u32,
 }
 
-/// Floats per location of a [`PlateauVertex`], for the vertex input.
-pub const PLATEAU_VERTEX_FLOATS: [u32; 4] = [3, 2, 2, 1];
+/// Slack of the inverse map's s and t at the patch's sides (f32 rounding): a fragment on a side
+/// shared with a neighbour is drawn by both rather than by neither.
+const SHEET_SLACK: f32 = 1e-4;
 
-/// The silhouette a vertex is measured from, and its caster.
-#[derive(Clone, Copy, Debug)]
-struct Foot {
-    at: Vec2,
-    normal: Vec2,
-    caster: f32,
-}
+impl Sheet {
+    fn new(a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> Self {
+        let hull = hull_triangles([a, b, tb, ta]).iter().enumerate().fold(0, |bits, (k, &c)| bits | (c << (2 * k)));
+        Sheet { a: a.into(), b: b.into(), ta: ta.into(), tb: tb.into(), normal: normal.into(), caster, hull }
+    }
 
-impl PlateauVertex {
-    fn new(p: Vec2, t: f32, foot: Foot) -> Self {
-        PlateauVertex { u: p.x, v: p.y, t, foot: foot.at.into(), normal: foot.normal.into(), caster: foot.caster }
+    /// The corners, in the order the hull numbers them: a, b, tb, ta.
+    pub fn corners(&self) -> [Vec2; 4] {
+        [self.a, self.b, self.tb, self.ta].map(Vec2::from)
+    }
+
+    /// The six points of the two hull triangles the GPU draws.
+    pub fn hull_points(&self) -> [Vec2; 6] {
+        let corners = self.corners();
+        std::array::from_fn(|k| corners[(self.hull >> (2 * k) & 3) as usize])
+    }
+
+    /// The patch's point at (s, t).
+    pub fn point(&self, s: f32, t: f32) -> Vec2 {
+        let [a, b, tb, ta] = self.corners();
+        a.lerp(b, s).lerp(ta.lerp(tb, s), t)
+    }
+
+    /// The plateau parameter at `p` and the hard edge's parameter s of its foot: the smallest t
+    /// of the patch over `p` (where it folds over itself two cover it; min blending of the
+    /// tessellation kept the smaller), `None` off the patch. What `glsl/plateau/penumbra.frag`
+    /// computes per fragment: with e = b − a, f = ta − a, g = tb − ta − e and q = p − a,
+    /// q = s·e + t·f + s·t·g; crossing with e + t·g removes s, leaving
+    /// (f × g)·t² + (f × e − q × g)·t − q × e = 0, solved in the form without cancellation for
+    /// either root.
+    pub fn at(&self, p: Vec2) -> Option<(f32, f32)> {
+        let [a, b, tb, ta] = self.corners();
+        let (e, f, q) = (b - a, ta - a, p - a);
+        let g = tb - ta - e;
+        let (qa, qb, qc) = (f.perp_dot(g), f.perp_dot(e) - q.perp_dot(g), -q.perp_dot(e));
+        let d = qb * qb - 4.0 * qa * qc;
+        if d < 0.0 {
+            return None;
+        }
+        let h = -0.5 * (qb + d.sqrt().copysign(qb));
+        let roots = [if h != 0.0 { qc / h } else { f32::NAN }, if qa != 0.0 { h / qa } else { f32::NAN }];
+        let mut best: Option<(f32, f32)> = None;
+        for t in roots {
+            if !(-SHEET_SLACK..=1.0).contains(&t) {
+                continue; // NaN too
+            }
+            let side = e + g * t;
+            let s = (q - f * t).dot(side) / side.length_squared();
+            if (-SHEET_SLACK..=1.0 + SHEET_SLACK).contains(&s) && best.is_none_or(|(u, _)| t < u) {
+                best = Some((t.max(0.0), s.clamp(0.0, 1.0)));
+            }
+        }
+        best
     }
 }
 
-/// Triangles of the plateau's sides, cones apart from sheets (the paper's two primitives, each
-/// its own timed pass).
+/// The convex hull of a quadrilateral's corners as two triangles of corner numbers, anticlockwise
+/// (a triangular hull: the second degenerate). Andrew's monotone chain on four points.
+fn hull_triangles(p: [Vec2; 4]) -> [u32; 6] {
+    // Sorted by x, then y, with the five exchanges of a sorting network (a sort call with its
+    // comparison closure cost more than the rest of a sheet).
+    let mut order = [0u32, 1, 2, 3];
+    for (i, j) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+        let (a, b) = (p[order[i] as usize], p[order[j] as usize]);
+        if b.x < a.x || b.x == a.x && b.y < a.y {
+            order.swap(i, j);
+        }
+    }
+    let turn = |o: u32, a: u32, b: u32| (p[a as usize] - p[o as usize]).perp_dot(p[b as usize] - p[o as usize]);
+    let mut hull = [0u32; 8];
+    let mut n = 0;
+    for pass in [[0, 1, 2, 3], [3, 2, 1, 0]] {
+        let start = n;
+        for k in pass {
+            let c = order[k];
+            while n >= start + 2 && turn(hull[n - 2], hull[n - 1], c) <= 0.0 {
+                n -= 1;
+            }
+            hull[n] = c;
+            n += 1;
+        }
+        n -= 1; // the last point starts the other chain
+    }
+    let at = |k: usize| hull[k.min(n.max(1) - 1)];
+    [at(0), at(1), at(2), at(0), at(2), at(3.min(n - 1).max(2))]
+}
+
+/// A piece of a vertex cone (§2) as one primitive: the part over the base's rim angles
+/// `from`..`to` (at most a quarter turn and a little), t rising linearly from 0 at the apex to
+/// 1 on the rim. In the base's unit-disk coordinates x (plane point apex + axes·(x + lean)) the
+/// rim is |x| = 1 and the apex −lean, so t at y = x + lean is the s > 0 with |y/s − lean| = 1:
+/// exact, where the paper's fan of `segments` flat triangles was polygonal ([`Wedge::t_at`]).
+/// Drawn as the triangle apex→rim(from)→rim(to) and the trapezoid from that chord out to the
+/// rim's tangent at the middle angle, which hold the piece whatever the apex's place.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Wedge {
+    pub apex: [f32; 2],
+    /// axes⁻¹ · (base centre − apex).
+    pub lean: [f32; 2],
+    /// The base's semi-axes (columns, x then y).
+    pub axes: [f32; 4],
+    pub from: f32,
+    pub to: f32,
+    pub caster: f32,
+    pad: f32,
+}
+
+/// The widest rim arc of one [`Wedge`]: a quarter turn keeps its trapezoid within √2 of the rim.
+const WEDGE_SPAN: f32 = std::f32::consts::FRAC_PI_2 + 2.0 * WEDGE_OVERLAP;
+
+impl Wedge {
+    fn axes(&self) -> Mat2 {
+        Mat2::from_cols_array(&self.axes)
+    }
+
+    /// The nine points of the three triangles the GPU draws, in the plane.
+    pub fn outline(&self) -> [Vec2; 9] {
+        let half = 0.5 * (self.to - self.from);
+        let (u0, u1) = (Vec2::from_angle(self.from), Vec2::from_angle(self.to));
+        let (far0, far1) = (u0 / half.cos(), u1 / half.cos());
+        let lean = Vec2::from(self.lean);
+        let unit = [-lean, u0, u1, u0, far0, far1, u0, far1, u1];
+        let (apex, axes) = (Vec2::from(self.apex), self.axes());
+        unit.map(|x| apex + axes * (x + lean))
+    }
+
+    /// The cone's t at `p` (beyond 1 off the base): with y = axes⁻¹·(p − apex), the positive
+    /// root of (1 − |lean|²)·t² + 2·(y·lean)·t − |y|² = 0, in the form without cancellation (the
+    /// apex lies inside the base: |lean| < 1).
+    pub fn t_at(&self, p: Vec2) -> f32 {
+        let (y, lean) = (self.axes().inverse() * (p - Vec2::from(self.apex)), Vec2::from(self.lean));
+        let (yy, yl) = (y.length_squared(), y.dot(lean));
+        let root = yl + (yl * yl + (1.0 - lean.length_squared()) * yy).sqrt();
+        if yy == 0.0 { 0.0 } else { yy / root }
+    }
+}
+
+/// The plateau's sides, cones apart from sheets (the paper's two primitives, each its own timed
+/// pass), one record per primitive.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlateauGeometry {
-    pub cones: Vec<PlateauVertex>,
-    pub sheets: Vec<PlateauVertex>,
+    pub cones: Vec<Wedge>,
+    pub sheets: Vec<Sheet>,
     /// Plane-space bounds of the shadow: the projected caster (the umbra, even when the
     /// penumbra has no width) and every cone and sheet.
     pub footprint: Option<(Vec2, Vec2)>,
@@ -282,51 +447,43 @@ impl PlateauGeometry {
     }
 
     /// The part of a cone over the rim angles `from`..`to` (radians, `from` < `to` ≤ `from` +
-    /// 2π) as a triangle fan, apex at t = 0, rim at t = 1: its rim points at the multiples of
-    /// 2π/`segments` between the two ends, and at both ends.
-    fn push_wedge(&mut self, cone: &Cone, (from, to): (f32, f32), segments: u32, caster: f32) {
-        let step = std::f32::consts::TAU / segments as f32;
-        let foot = Foot { at: cone.centre, normal: Vec2::ZERO, caster };
-        let apex = PlateauVertex::new(cone.centre, 0.0, foot);
-        let (mut angle, mut rim) = (from, cone.rim(from));
-        self.grow(rim);
-        for k in (from / step).floor() as i32 + 1.. {
-            let next = (k as f32 * step).min(to);
-            let next_rim = cone.rim(next);
-            self.grow(next_rim);
-            self.cones.extend([apex, PlateauVertex::new(rim, 1.0, foot), PlateauVertex::new(next_rim, 1.0, foot)]);
-            if next >= to || next <= angle {
-                break;
-            }
-            (angle, rim) = (next, next_rim);
+    /// 2π), as pieces of at most [`WEDGE_SPAN`]. A cone without area (a flat base) draws nothing.
+    fn push_wedge(&mut self, cone: &Cone, (from, to): (f32, f32), caster: f32) {
+        if cone.axes.determinant() <= 0.0 {
+            return;
+        }
+        let lean = cone.axes.inverse() * cone.offset;
+        // The base's bounding box, once per cone: what the pieces draw past the rim has t > 1
+        // and is discarded, so it need not fit in the texture.
+        let reach = Vec2::new(cone.axes.row(0).length(), cone.axes.row(1).length());
+        let base = cone.centre + cone.offset;
+        [cone.centre, base - reach, base + reach].into_iter().for_each(|p| self.grow(p));
+        let pieces = ((to - from) / WEDGE_SPAN).ceil().max(1.0);
+        let step = (to - from) / pieces;
+        for k in 0..pieces as u32 {
+            let (a, b) = (from + step * k as f32, from + step * (k + 1) as f32);
+            let wedge = Wedge {
+                apex: cone.centre.into(),
+                lean: lean.into(),
+                axes: cone.axes.to_cols_array(),
+                from: a,
+                to: b,
+                caster,
+                pad: 0.0,
+            };
+            self.cones.push(wedge);
         }
     }
 
-    /// The sheet between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1): a
-    /// Coons patch bounded by four lines, tessellated so that Gouraud interpolation of t over
-    /// each flat triangle strays from the bilinear patch by under 1% (paper Figure 4, §3).
-    /// `normal`: the edge's unit normal, `caster`: the caster's number (see [`PlateauVertex`]).
-    /// False when the sheet has no width (a hard edge): nothing drawn.
+    /// The sheet between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1), see
+    /// [`Sheet`]. `normal`: the edge's unit normal, `caster`: the caster's number. False when
+    /// the sheet has no width (a hard edge): nothing drawn.
     fn push_sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> bool {
-        let width = (ta - a).length().min((tb - b).length()).max((ta - a).length().max((tb - b).length()) * 1e-3);
-        if width == 0.0 {
+        if (ta - a).length_squared().max((tb - b).length_squared()) == 0.0 {
             return false;
         }
-        // Bilinear between straight sides: the patch lies in its corners' hull.
         [a, b, ta, tb].into_iter().for_each(|p| self.grow(p));
-        let twist = ((tb - ta) - (b - a)).length();
-        let n = ((twist / (0.04 * width)).sqrt().ceil() as usize).clamp(1, 32);
-        let at = |i: usize, j: usize| {
-            let (s, t) = (i as f32 / n as f32, j as f32 / n as f32);
-            let foot = Foot { at: a.lerp(b, s), normal, caster };
-            PlateauVertex::new(foot.at.lerp(ta.lerp(tb, s), t), t, foot)
-        };
-        for i in 0..n {
-            for j in 0..n {
-                let (p00, p10, p01, p11) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
-                self.sheets.extend([p00, p10, p11, p00, p11, p01]);
-            }
-        }
+        self.sheets.push(Sheet::new(a, b, ta, tb, normal, caster));
         true
     }
 }
@@ -347,39 +504,49 @@ pub struct PlateauLight {
     pub radius: f32,
     pub size: PenumbraSize,
     pub penumbra: Penumbra,
-    /// Triangles per cone.
-    pub cone_segments: u32,
     /// Only the parts of the cones between the sheets (issue 18), or whole cones (§2).
     pub wedges: bool,
 }
 
-/// The plateau sides of one caster, numbered `number` (what its vertices carry): a sheet along
-/// each penumbra edge, on its outer side and, centred, on its inner side, and at each penumbra
-/// vertex the parts of its cone that no sheet there covers.
+/// The edges a caster's plateau follows, each with the third vertex of its light-facing
+/// triangle (see [`penumbra_edges`]); `facing` from the mesh's face planes
+/// ([`FacePlanes::light_facing`](super::silhouette::FacePlanes::light_facing)), as the smoothie
+/// finds it. With
+/// [`EdgeSource::Silhouettes`], an open mesh's edges also include the boundary edges of its
+/// back-facing triangles: with the silhouettes and the lit boundary edges they bound its whole
+/// shadow, which [`EdgeSource::LightFacing`] (every lit edge) covers with sides that mostly lie
+/// inside it.
+pub fn plateau_edges(caster: &Caster<'_>, facing: &Facing, source: EdgeSource) -> Vec<([u32; 2], u32)> {
+    let mut edges = penumbra_edges(caster, facing, source);
+    if source == EdgeSource::Silhouettes && !caster.adjacency.is_closed() {
+        edges.extend(unlit_boundary_edges(caster, facing));
+    }
+    edges
+}
+
+/// The plateau sides of one caster, numbered `number` (what its primitives carry): a sheet
+/// along each of its penumbra `edges` ([`plateau_edges`]), on its outer side and, centred, on
+/// its inner side, and at each penumbra vertex the parts of its cone that no sheet there covers.
+/// `caster` may stay in object space, placed by `model` (object → world): only the edges'
+/// vertices are transformed (issue 18: a moving frame transformed all of them).
 ///
 /// Corner wedges instead of Haines' whole cones (§2; issue 18: on a fine mesh, whose edges are
 /// much shorter than the penumbra, whole cones drew each texel some nine times). Where a sheet
 /// leaves the vertex it is the cones' envelope, never above them; what the cone alone must
 /// draw lies between the sheets: a convex corner's wedge, the outer half of a lone vertex.
 /// Outer only, the inner side counts as covered: the hard shadow there is t = 0 whatever the
-/// sides hold (the resolve).
-///
-/// With [`EdgeSource::Silhouettes`], an open mesh's sides also follow the boundary edges of
-/// its back-facing triangles: with the silhouettes and the lit boundary edges they bound its
-/// whole shadow, which [`EdgeSource::LightFacing`] (every lit edge) covers with sides that
-/// mostly lie inside it.
+/// sides hold (the resolve). `source` says what the edges are: [`EdgeSource::LightFacing`]'s
+/// need not bound an open mesh's shadow, so the footprint then holds every projected vertex.
 pub fn plateau_sides(
     plane: &ReceiverPlane,
     light: &PlateauLight,
     caster: &Caster<'_>,
-    number: f32,
+    model: &Mat4,
+    edges: &[([u32; 2], u32)],
     source: EdgeSource,
+    number: f32,
 ) -> PlateauGeometry {
-    let facing = light_facing(caster, light.position);
-    let mut edges = penumbra_edges(caster, &facing, source);
-    if source == EdgeSource::Silhouettes && !caster.adjacency.is_closed() {
-        edges.extend(unlit_boundary_edges(caster, &facing));
-    }
+    let world = |v: u32| model.transform_point3(caster.positions[v as usize]);
     // Each edge end (2i, 2i + 1 for edge i) to its vertex's cone, computed once per vertex.
     let mut ends: Vec<(u32, u32)> =
         edges.iter().enumerate().flat_map(|(i, ([a, b], _))| [(*a, 2 * i as u32), (*b, 2 * i as u32 + 1)]).collect();
@@ -387,7 +554,7 @@ pub fn plateau_sides(
     let groups: Vec<&[(u32, u32)]> = ends.chunk_by(|x, y| x.0 == y.0).collect();
     let cones: Vec<Option<Cone>> = groups
         .par_iter()
-        .map(|g| vertex_cone(plane, light.position, light.radius, light.size, caster.positions[g[0].0 as usize]))
+        .map(|g| vertex_cone(plane, light.position, light.radius, light.size, world(g[0].0)))
         .collect();
     let mut cone_of_end = vec![0u32; ends.len()];
     for (k, g) in groups.iter().enumerate() {
@@ -405,7 +572,7 @@ pub fn plateau_sides(
             for (j, &(_, inner)) in chunk.iter().enumerate() {
                 let i = c * PARALLEL_CHUNK + j;
                 let ends = (cone(2 * i), cone(2 * i + 1));
-                let inside = plane.project(light.position, caster.positions[inner as usize]);
+                let inside = plane.project(light.position, world(inner));
                 covers.extend(edge_sheets(&mut out, light.penumbra, ends, inside, number));
             }
             (out, covers)
@@ -433,11 +600,14 @@ pub fn plateau_sides(
         })
         .collect();
     wedges.iter().for_each(|g| out.extend(g));
-    let hl = plane.height(light.position);
-    out.unbounded = caster.positions.iter().any(|p| plane.height(*p) >= hl * (1.0 - ABOVE_LIGHT));
+    // Heights are affine in object space: h(model·p) = up·p + base, no vertex transformed.
+    let up = model.transpose().transform_vector3(plane.normal);
+    let base = plane.height(model.transform_point3(Vec3::ZERO));
+    let reach = plane.height(light.position) * (1.0 - ABOVE_LIGHT) - base;
+    out.unbounded = caster.positions.par_iter().any(|p| up.dot(*p) >= reach);
     if source == EdgeSource::LightFacing {
         // Lit edges alone need not bound an open mesh's shadow: its back faces cast too.
-        for q in caster.positions.iter().filter_map(|p| plane.project(light.position, *p)) {
+        for q in (0..caster.positions.len() as u32).filter_map(|v| plane.project(light.position, world(v))) {
             out.grow(q);
         }
     }
@@ -496,13 +666,14 @@ fn vertex_wedges(
     (arcs, gaps): (&mut Arcs, &mut Arcs),
     number: f32,
 ) {
-    if cone.is_point() {
+    // A point or a flat base has no area to draw (and no rim angles).
+    if cone.axes.determinant() <= 0.0 {
         return;
     }
     arcs.clear();
     gaps.clear();
-    // Whole cones, or a flat base (no width across, no rim angles): the whole cone.
-    if let Some(inverse) = (light.wedges && cone.axes.determinant() > 0.0).then(|| cone.axes.inverse()) {
+    if light.wedges {
+        let inverse = cone.axes.inverse();
         for (from, to) in covered {
             // Anticlockwise from one side of the sector to the other; a flat sector covers nothing.
             let (from, to) = if from.perp_dot(to) >= 0.0 { (from, to) } else { (to, from) };
@@ -516,7 +687,7 @@ fn vertex_wedges(
     let overlap = if arcs.is_empty() { 0.0 } else { WEDGE_OVERLAP };
     uncovered(arcs, gaps);
     for &(from, to) in gaps.iter() {
-        out.push_wedge(cone, (from - overlap, to + overlap), light.cone_segments, number);
+        out.push_wedge(cone, (from - overlap, to + overlap), number);
     }
 }
 
@@ -560,6 +731,7 @@ fn unlit_boundary_edges<'a>(caster: &'a Caster<'_>, facing: &'a [bool]) -> impl 
 mod tests {
     use super::*;
     use crate::geometry::EdgeAdjacency;
+    use crate::geometry::silhouette::FacePlanes;
     use proptest::prelude::*;
 
     fn circle(x: f32, y: f32, r: f32) -> Cone {
@@ -630,25 +802,54 @@ mod tests {
             }
         }
 
+        /// The inverse map (what penumbra.frag does per fragment) finds, at every point of a
+        /// patch, a root of the patch there and none lower than the point's own t; the hull the
+        /// GPU draws holds the whole patch. Random corners, so folded and triangular hulls too.
         #[test]
-        fn sheets_tessellate_by_twist_with_t_in_range((r0, r1) in radii(0.01)) {
+        fn sheets_invert_their_bilinear_map_inside_their_hull(
+            corners in prop::array::uniform4((-2.0f32..2.0, -2.0f32..2.0)),
+            s in 0.0f32..=1.0, t in 0.0f32..=1.0,
+        ) {
+            let [a, b, tb, ta] = corners.map(Vec2::from);
+            prop_assume!((b - a).length() > 0.05 && (ta - a).length() > 0.05 && (tb - b).length() > 0.05);
+            let sheet = Sheet::new(a, b, ta, tb, Vec2::Y, 1.0);
+            let p = sheet.point(s, t);
+            prop_assert!(in_triangles(&sheet.hull_points(), p), "{p} (s {s}, t {t}) outside the hull");
+            let (found, at) = sheet.at(p).expect("a point of the patch has a root");
+            prop_assert!(found <= t + 1e-3, "t {found} above the point's own {t}");
+            let back = sheet.point(at, found);
+            prop_assert!((back - p).length() < 2e-3 * (1.0 + p.length()), "({at}, {found}) maps to {back}, not {p}");
+        }
+
+        /// A wedge's t is exact: the point a fraction t of the way from the apex to the rim at
+        /// any angle of the piece has t, inside the outline the GPU draws; beyond the rim t > 1.
+        /// Cones of a low and a high light.
+        #[test]
+        fn wedges_give_the_exact_cone_inside_their_outline(
+            light in (-8.0f32..8.0, 1.5f32..9.0, -8.0f32..8.0),
+            (from, span) in (0.0f32..TAU, 0.01f32..WEDGE_SPAN),
+            (f, t) in (0.0f32..=1.0, 0.0f32..=1.0),
+        ) {
+            let plane = ReceiverPlane::ground(0.0);
+            let cone = vertex_cone(&plane, Vec3::from(light), 0.5, PenumbraSize::Physical { scale: 1.0 }, Vec3::new(0.3, 1.0, -0.2));
+            let cone = cone.unwrap();
             let mut g = PlateauGeometry::default();
-            let (a, b) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1));
-            let (ta, tb) = outer_tangent(&a, &b, Vec2::Y).unwrap();
-            g.push_sheet(a.centre, b.centre, ta, tb, Vec2::Y, 1.0);
-            prop_assert!(g.sheets.iter().all(|v| v.u.is_finite() && v.v.is_finite() && (0.0..=1.0).contains(&v.t)));
-            let quads = g.sheets.len() / 6;
-            if r0 == r1 {
-                prop_assert_eq!(quads, 1, "equal radii: one flat quad");
-            }
-            // Twice the radius difference never needs fewer cells.
-            prop_assume!(r1 + (r1 - r0) > 0.0);
-            let mut wider = PlateauGeometry::default();
-            let (a2, b2) = (circle(0.0, 0.0, r0), circle(3.0, 0.0, r1 + (r1 - r0)));
-            if let Some((ta2, tb2)) = outer_tangent(&a2, &b2, Vec2::Y) {
-                wider.push_sheet(a2.centre, b2.centre, ta2, tb2, Vec2::Y, 1.0);
-                prop_assert!(wider.sheets.len() / 6 >= quads || (r1 - r0).abs() < 1e-3);
-            }
+            g.push_wedge(&cone, (from, from + span), 1.0);
+            prop_assert_eq!(g.cones.len(), 1);
+            let wedge = g.cones[0];
+            let rim = rim(&cone, from + f * span);
+            let p = cone.centre.lerp(rim, t);
+            let scale = 1.0 + p.length();
+            prop_assert!(in_triangles(&wedge.outline(), p), "{p} outside the wedge's outline");
+            prop_assert!((wedge.t_at(p) - t).abs() < 1e-3 * scale, "t {} at {t} of the way", wedge.t_at(p));
+            let beyond = cone.centre.lerp(rim, 1.2);
+            prop_assert!(wedge.t_at(beyond) > 1.0 + 1e-3);
+        }
+
+        #[test]
+        fn the_rim_angles_atan2_is_libms_within_1e_5(angle in -std::f32::consts::PI..std::f32::consts::PI, r in 1e-3f32..1e3) {
+            let (y, x) = (r * angle.sin(), r * angle.cos());
+            prop_assert!((atan2(y, x) - y.atan2(x)).abs() < 1e-5, "{} vs {}", atan2(y, x), y.atan2(x));
         }
 
         #[test]
@@ -657,12 +858,12 @@ mod tests {
             let adjacency = EdgeAdjacency::build(&triangles);
             // A light outside the sphere (centre (0, 1.5, 0), radius 1) sees a silhouette.
             prop_assume!((Vec3::from(l) - Vec3::Y * 1.5).length() > 1.1);
-            let positions: Vec<Vec3> = sphere.iter().map(|p| *p + Vec3::Y * 1.5).collect();
-            let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-            let facing = light_facing(&caster, Vec3::from(l));
-            let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
+            let caster = Caster { positions: &sphere, triangles: &triangles, adjacency: &adjacency };
+            let model = Mat4::from_translation(Vec3::Y * 1.5);
+            let facing = FacePlanes::new(&sphere, &triangles).light_facing(&model, Vec3::from(l));
+            let edges = plateau_edges(&caster, &facing, EdgeSource::Silhouettes);
             prop_assert!(!edges.is_empty());
-            let mut degree = vec![0; positions.len()];
+            let mut degree = vec![0; sphere.len()];
             for ([a, b], inner) in &edges {
                 degree[*a as usize] += 1;
                 degree[*b as usize] += 1;
@@ -672,32 +873,169 @@ mod tests {
         }
     }
 
-    /// The smallest t any triangle of `vertices` gives each point of a `cells`² grid over
-    /// [lo, hi] (1 where none covers it): the plateau texture as min blending draws it.
-    fn plateau_field(vertices: &[PlateauVertex], (lo, hi): (Vec2, Vec2), cells: usize) -> Vec<f32> {
-        let mut field = vec![1.0f32; cells * cells];
+    /// The base's rim at angle φ: centre + offset + axes·(cos φ, sin φ) (the wedges' angles).
+    fn rim(cone: &Cone, angle: f32) -> Vec2 {
+        cone.centre + cone.offset + cone.axes * Vec2::from_angle(angle)
+    }
+
+    /// Whether `p` lies in one of the triangles `points` holds three by three (a little slack).
+    fn in_triangles(points: &[Vec2], p: Vec2) -> bool {
+        points.chunks(3).any(|t| {
+            let area = (t[1] - t[0]).perp_dot(t[2] - t[0]);
+            let w = [(t[1] - p).perp_dot(t[2] - p), (t[2] - p).perp_dot(t[0] - p), (t[0] - p).perp_dot(t[1] - p)];
+            let slack = 1e-4 * area.abs().max(1e-6);
+            area != 0.0 && w.iter().all(|w| w * area.signum() >= -slack)
+        })
+    }
+
+    /// The sides of a caster in object space placed by `model`, from its face planes, as the
+    /// technique builds them.
+    fn sides(light: &PlateauLight, caster: &Caster<'_>, model: &Mat4, number: f32) -> PlateauGeometry {
+        let facing = FacePlanes::new(caster.positions, caster.triangles).light_facing(model, light.position);
+        let edges = plateau_edges(caster, &facing, EdgeSource::Silhouettes);
+        plateau_sides(&ReceiverPlane::ground(0.0), light, caster, model, &edges, EdgeSource::Silhouettes, number)
+    }
+
+    /// Calls `f` with each centre of a `cells`² grid over [lo, hi] inside the triangle `tri`.
+    fn raster(tri: [Vec2; 3], (lo, hi): (Vec2, Vec2), cells: usize, mut f: impl FnMut(usize, Vec2, [f32; 3])) {
         let cell = (hi - lo) / cells as f32;
-        for tri in vertices.chunks(3) {
-            let p = tri.iter().map(|v| (Vec2::new(v.u, v.v) - lo) / cell).collect::<Vec<_>>();
-            let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-            if area.abs() < 1e-12 {
-                continue;
-            }
-            let (min, max) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
-            for y in (min.y.floor().max(0.0) as usize)..(max.y.ceil().min(cells as f32) as usize) {
-                for x in (min.x.floor().max(0.0) as usize)..(max.x.ceil().min(cells as f32) as usize) {
-                    let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                    let w =
-                        [(p[1] - q).perp_dot(p[2] - q), (p[2] - q).perp_dot(p[0] - q), (p[0] - q).perp_dot(p[1] - q)]
-                            .map(|w| w / area);
-                    if w.iter().all(|w| *w >= -1e-6) {
-                        let t = w[0] * tri[0].t + w[1] * tri[1].t + w[2] * tri[2].t;
-                        field[y * cells + x] = field[y * cells + x].min(t);
-                    }
+        let p = tri.map(|v| (v - lo) / cell);
+        let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        if area.abs() < 1e-12 {
+            return;
+        }
+        let (min, max) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        for y in (min.y.floor().max(0.0) as usize)..(max.y.ceil().min(cells as f32) as usize) {
+            for x in (min.x.floor().max(0.0) as usize)..(max.x.ceil().min(cells as f32) as usize) {
+                let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let w = [(p[1] - q).perp_dot(p[2] - q), (p[2] - q).perp_dot(p[0] - q), (p[0] - q).perp_dot(p[1] - q)]
+                    .map(|w| w / area);
+                if w.iter().all(|w| *w >= -1e-6) {
+                    f(y * cells + x, lo + q * cell, w);
                 }
             }
         }
+    }
+
+    /// The plateau texture as the GPU draws these primitives: per cell of a `cells`² grid over
+    /// `bounds`, the smallest t of any wedge or sheet whose drawn triangles hold the cell's
+    /// centre and that has a root there (1 where none does).
+    fn plateau_field(g: &PlateauGeometry, bounds: (Vec2, Vec2), cells: usize) -> Vec<f32> {
+        let mut field = vec![1.0f32; cells * cells];
+        for wedge in &g.cones {
+            for tri in wedge.outline().chunks(3) {
+                raster([tri[0], tri[1], tri[2]], bounds, cells, |i, p, _| field[i] = field[i].min(wedge.t_at(p)));
+            }
+        }
+        for sheet in &g.sheets {
+            for tri in sheet.hull_points().chunks(3) {
+                raster([tri[0], tri[1], tri[2]], bounds, cells, |i, p, _| {
+                    if let Some((t, _)) = sheet.at(p) {
+                        field[i] = field[i].min(t);
+                    }
+                });
+            }
+        }
         field
+    }
+
+    /// The smallest t of Gouraud triangles (points and t, three by three) per cell: what min
+    /// blending of a tessellation draws.
+    fn tessellated_field(triangles: &[(Vec2, f32)], bounds: (Vec2, Vec2), cells: usize) -> Vec<f32> {
+        let mut field = vec![1.0f32; cells * cells];
+        for tri in triangles.chunks(3) {
+            raster([tri[0].0, tri[1].0, tri[2].0], bounds, cells, |i, _, w| {
+                field[i] = field[i].min(w[0] * tri[0].1 + w[1] * tri[1].1 + w[2] * tri[2].1)
+            });
+        }
+        field
+    }
+
+    /// The paper's construction (§2, Figure 4), independent of the primitives: a sheet as an
+    /// n × n grid of Gouraud quads, a cone as a fan of n flat triangles.
+    fn tessellate_sheet(s: &Sheet, n: usize) -> Vec<(Vec2, f32)> {
+        let at = |i: usize, j: usize| {
+            let (u, t) = (i as f32 / n as f32, j as f32 / n as f32);
+            (s.point(u, t), t)
+        };
+        let quads = (0..n).flat_map(|i| (0..n).map(move |j| (i, j)));
+        quads
+            .flat_map(|(i, j)| [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)])
+            .collect()
+    }
+
+    fn tessellate_cone(cone: &Cone, n: usize) -> Vec<(Vec2, f32)> {
+        let rim = |k: usize| (rim(cone, TAU * k as f32 / n as f32), 1.0);
+        (0..n).flat_map(|k| [(cone.centre, 0.0), rim(k), rim(k + 1)]).collect()
+    }
+
+    /// Issue 18: the analytic primitives draw the plateau of the paper's tessellation, finely
+    /// cut: sheets (tilted plate, low light: twisted; a knot's folds) and whole cones within
+    /// 1/255 of t wherever both cover, over the same cells but for their rims.
+    #[test]
+    fn analytic_sides_draw_the_finely_tessellated_plateau() {
+        let shapes =
+            [crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0)), crate::geometry::shapes::torus_knot(600)];
+        for (shape, (mesh, triangles)) in shapes.iter().enumerate() {
+            let adjacency = EdgeAdjacency::build(triangles);
+            let model = Mat4::from_translation(Vec3::Y * 1.6) * Mat4::from_rotation_x(0.4);
+            let caster = Caster { positions: mesh, triangles, adjacency: &adjacency };
+            for position in [Vec3::new(0.5, 8.0, 0.3), Vec3::new(-6.0, 3.0, 2.0)] {
+                let light = PlateauLight {
+                    position,
+                    radius: 0.6,
+                    size: PenumbraSize::Physical { scale: 1.0 },
+                    penumbra: Penumbra::Centred,
+                    wedges: false,
+                };
+                let g = sides(&light, &caster, &model, 1.0);
+                let bounds = g.footprint.unwrap();
+                let cells = 200;
+                let mut vertices: Vec<u32> = edges_of(&light, &caster, &model).iter().flat_map(|(e, _)| *e).collect();
+                vertices.sort_unstable();
+                vertices.dedup();
+                let cone = |v: &u32| {
+                    let p = model.transform_point3(mesh[*v as usize]);
+                    vertex_cone(&ReceiverPlane::ground(0.0), position, light.radius, light.size, p).unwrap()
+                };
+                // Primitive by primitive, against its own tessellation: each pair of fields over
+                // the cells either covers.
+                let sheets = g.sheets.iter().map(|s| {
+                    let one = PlateauGeometry { sheets: vec![*s], ..Default::default() };
+                    (plateau_field(&one, bounds, cells), tessellated_field(&tessellate_sheet(s, 48), bounds, cells))
+                });
+                let whole_cones = vertices.iter().map(cone).filter(|c| c.axes.determinant() > 0.0);
+                let mut pieces = PlateauGeometry::default();
+                let cones = whole_cones.map(|c| {
+                    pieces.cones.clear();
+                    pieces.push_wedge(&c, (0.0, TAU), 1.0);
+                    (plateau_field(&pieces, bounds, cells), tessellated_field(&tessellate_cone(&c, 720), bounds, cells))
+                });
+                for (what, pairs) in [("sheets", sheets.collect::<Vec<_>>()), ("cones", cones.collect())] {
+                    let (mut worst, mut covered, mut one_only) = (0.0f32, 0, 0);
+                    for (got, want) in &pairs {
+                        for (g, w) in got.iter().zip(want) {
+                            match (*g < 1.0, *w < 1.0) {
+                                (true, true) => (worst, covered) = (worst.max((g - w).abs()), covered + 1),
+                                (false, false) => {}
+                                _ => one_only += 1,
+                            }
+                        }
+                    }
+                    let case = format!("shape {shape}, light {position}, {what}");
+                    assert!(covered > 1000, "{case}: {covered} cells");
+                    assert!(worst <= 1.0 / 255.0, "{case}: t differs by {worst}");
+                    // Cells on the sides and rims, where a centre lies on the line or t nears 1.
+                    assert!(one_only * 20 <= covered, "{case}: {one_only} of {covered} cells covered by one alone");
+                }
+            }
+        }
+    }
+
+    /// The penumbra edges of a caster in object space, from its face planes.
+    fn edges_of(light: &PlateauLight, caster: &Caster<'_>, model: &Mat4) -> Vec<([u32; 2], u32)> {
+        let facing = FacePlanes::new(caster.positions, caster.triangles).light_facing(model, light.position);
+        plateau_edges(caster, &facing, EdgeSource::Silhouettes)
     }
 
     /// Issue 18: corner wedges and sheets give the plateau whole cones and sheets give (Haines
@@ -717,8 +1055,7 @@ mod tests {
         for (shape, (mesh, triangles)) in shapes.iter().enumerate() {
             let adjacency = EdgeAdjacency::build(triangles);
             let tilt = Mat4::from_translation(Vec3::Y * 1.6) * Mat4::from_rotation_x(0.4);
-            let positions: Vec<Vec3> = mesh.iter().map(|p| tilt.transform_point3(*p)).collect();
-            let caster = Caster { positions: &positions, triangles, adjacency: &adjacency };
+            let caster = Caster { positions: mesh, triangles, adjacency: &adjacency };
             for (position, penumbra) in [
                 (Vec3::new(0.5, 8.0, 0.3), Penumbra::Centred),
                 (Vec3::new(-6.0, 4.0, 2.0), Penumbra::Centred),
@@ -729,40 +1066,33 @@ mod tests {
                     radius: 0.6,
                     size: PenumbraSize::Physical { scale: 1.0 },
                     penumbra,
-                    cone_segments: 32,
                     wedges: true,
                 };
-                let sides = plateau_sides(&plane, &light, &caster, 1.0, EdgeSource::Silhouettes);
-                // The same sheets with a whole cone at every penumbra vertex.
-                let mut whole = PlateauGeometry { sheets: sides.sheets.clone(), ..Default::default() };
-                let facing = light_facing(&caster, position);
-                let mut vertices: Vec<u32> =
-                    penumbra_edges(&caster, &facing, EdgeSource::Silhouettes).iter().flat_map(|(e, _)| *e).collect();
-                vertices.sort_unstable();
-                vertices.dedup();
-                for v in vertices {
-                    let cone = vertex_cone(&plane, position, light.radius, light.size, positions[v as usize]).unwrap();
-                    whole.push_wedge(&cone, (0.0, TAU), light.cone_segments, 1.0);
-                }
-                let bounds = sides.footprint.unwrap();
+                let wedged = sides(&light, &caster, &tilt, 1.0);
+                // Whole cones on request: a full turn at every penumbra vertex.
+                let whole = sides(&PlateauLight { wedges: false, ..light }, &caster, &tilt, 1.0);
+                assert_eq!(wedged.sheets, whole.sheets);
+                let bounds = wedged.footprint.unwrap();
                 let cells = 160;
-                let (wedges, cones) =
-                    (plateau_field(&sides.cones, bounds, cells), plateau_field(&whole.cones, bounds, cells));
-                let sheets = plateau_field(&sides.sheets, bounds, cells);
-                // Outer only, the hard shadow's texels do not count: the projected triangles.
-                let shadow = plateau_field(
-                    &triangles
-                        .iter()
-                        .flat_map(|t| t.map(|v| plane.project(position, positions[v as usize]).unwrap()))
-                        .map(|p| PlateauVertex::new(p, 0.0, Foot { at: p, normal: Vec2::ZERO, caster: 1.0 }))
-                        .collect::<Vec<_>>(),
+                let sheets = plateau_field(
+                    &PlateauGeometry { sheets: wedged.sheets.clone(), ..Default::default() },
                     bounds,
                     cells,
                 );
+                let field = |g: &PlateauGeometry| {
+                    plateau_field(&PlateauGeometry { cones: g.cones.clone(), ..Default::default() }, bounds, cells)
+                };
+                let (wedges, cones) = (field(&wedged), field(&whole));
+                // Outer only, the hard shadow's texels do not count: the projected triangles.
+                let mut shadow = vec![false; cells * cells];
+                for t in triangles.iter() {
+                    let tri = t.map(|v| plane.project(position, tilt.transform_point3(mesh[v as usize])).unwrap());
+                    raster(tri, bounds, cells, |i, _, _| shadow[i] = true);
+                }
                 let (mut worst, mut off, mut penumbra_cells) = (0.0f32, 0, 0);
                 for i in 0..cells * cells {
                     let t = cones[i].min(sheets[i]);
-                    if penumbra == Penumbra::Outer && shadow[i] == 0.0 || t == 1.0 {
+                    if penumbra == Penumbra::Outer && shadow[i] || t == 1.0 {
                         continue;
                     }
                     let d = (wedges[i].min(sheets[i]) - t).abs();
@@ -778,21 +1108,8 @@ mod tests {
                     "{what}: {off} of {penumbra_cells} penumbra cells differ by over 1/255"
                 );
                 // And the wedges are a fraction of the cones.
-                assert!(
-                    sides.cones.len() * 2 < whole.cones.len(),
-                    "shape {shape}: {} of {}",
-                    sides.cones.len(),
-                    whole.cones.len()
-                );
-                // Whole cones on request: the same as the plateau of whole cones.
-                let haines = plateau_sides(
-                    &plane,
-                    &PlateauLight { wedges: false, ..light },
-                    &caster,
-                    1.0,
-                    EdgeSource::Silhouettes,
-                );
-                assert_eq!(haines.cones, whole.cones);
+                let (a, b) = (wedged.cones.len(), whole.cones.len());
+                assert!(a * 2 < b, "shape {shape}: {a} of {b}");
             }
         }
     }
@@ -803,9 +1120,8 @@ mod tests {
     fn a_square_has_a_quarter_cone_at_each_corner() {
         let (cube, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
         let adjacency = EdgeAdjacency::build(&triangles);
-        let positions: Vec<Vec3> = cube.iter().map(|p| *p + Vec3::Y).collect();
-        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-        let plane = ReceiverPlane::ground(0.0);
+        let caster = Caster { positions: &cube, triangles: &triangles, adjacency: &adjacency };
+        let model = Mat4::from_translation(Vec3::Y);
         let half = 9.0 / 7.95; // the top face (y = 1.05) casts the square |x|, |z| ≤ half
         // Haines' constant factor: circles, of one radius at one height.
         for penumbra in [Penumbra::Outer, Penumbra::Centred] {
@@ -814,21 +1130,18 @@ mod tests {
                 radius: 0.5,
                 size: PenumbraSize::Haines { factor: 0.1 },
                 penumbra,
-                cone_segments: 32,
                 wedges: true,
             };
-            let g = plateau_sides(&plane, &light, &caster, 1.0, EdgeSource::Silhouettes);
-            // 90° of 32 segments, and the overlap past each side: 8 to 10 triangles per corner.
-            let triangles = g.cones.len() / 3;
-            assert!((4 * 8..=4 * 10).contains(&triangles), "{penumbra:?}: {triangles} cone triangles");
+            let g = sides(&light, &caster, &model, 1.0);
+            // 90° and the overlap past each side: one piece per corner.
+            assert_eq!(g.cones.len(), 4, "{penumbra:?}: {} wedges", g.cones.len());
             let mut turned = 0.0;
-            for tri in g.cones.chunks(3) {
-                let [apex, a, b] = [tri[0], tri[1], tri[2]].map(|v| Vec2::new(v.u, v.v));
+            for w in &g.cones {
+                let apex = Vec2::from(w.apex);
                 assert!((apex.abs() - Vec2::splat(half)).abs().max_element() < 1e-3, "apexes at the corners");
-                let middle = 0.5 * (a + b);
-                let outside = middle.abs().min_element() > half - 1e-3; // but for the overlaps
-                assert!(outside, "{penumbra:?}: a wedge outside the shadow");
-                turned += (a - apex).angle_to(b - apex).abs();
+                let middle = apex + Mat2::from_cols_array(&w.axes) * Vec2::from_angle(0.5 * (w.from + w.to));
+                assert!(middle.abs().min_element() > half - 1e-3, "{penumbra:?}: a wedge outside the shadow");
+                turned += w.to - w.from;
             }
             let expected = 4.0 * (std::f32::consts::FRAC_PI_2 + 2.0 * WEDGE_OVERLAP);
             assert!((turned - expected).abs() < 1e-3, "{penumbra:?}: the wedges turn {turned}, not {expected}");
@@ -836,44 +1149,45 @@ mod tests {
     }
 
     /// Centred: every edge gets a second sheet on the inner side, mirror to the outer one, and
-    /// every vertex measures t from its foot on the hard edge (t·radius away, flat plate).
+    /// every sheet measures t from its foot on the hard edge (t·radius away, flat plate).
     #[test]
     fn centred_sheets_straddle_the_hard_edge() {
         let (cube, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
         let adjacency = EdgeAdjacency::build(&triangles);
-        let positions: Vec<Vec3> = cube.iter().map(|p| *p + Vec3::Y).collect();
-        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
-        let plane = ReceiverPlane::ground(0.0);
-        let sides = |penumbra| {
+        let caster = Caster { positions: &cube, triangles: &triangles, adjacency: &adjacency };
+        let at = |penumbra| {
             let light = PlateauLight {
                 position: Vec3::Y * 9.0,
                 radius: 0.5,
                 size: PenumbraSize::Physical { scale: 1.0 },
                 penumbra,
-                cone_segments: 8,
                 wedges: true,
             };
-            plateau_sides(&plane, &light, &caster, 3.0, EdgeSource::Silhouettes)
+            sides(&light, &caster, &Mat4::from_translation(Vec3::Y), 3.0)
         };
-        let (outer, centred) = (sides(Penumbra::Outer), sides(Penumbra::Centred));
-        // A sheet more per edge (each tessellated by its own twist).
-        assert!(centred.sheets.len() > outer.sheets.len());
+        let (outer, centred) = (at(Penumbra::Outer), at(Penumbra::Centred));
+        // A sheet more per edge.
+        assert_eq!(centred.sheets.len(), 2 * outer.sheets.len());
         assert!(outer.sheets.iter().all(|v| centred.sheets.contains(v)));
         // The top face (y = 1.05) casts the square |x|, |z| ≤ 9/7.95; the radius is W/2
         // overhead, a few per cent more towards the corners (their cones lean out).
         let half = 9.0 / 7.95;
         let r = 0.5 * 1.05 / 7.95;
         let (mut inside, mut outside) = (0, 0);
-        for v in &centred.sheets {
-            let (p, foot) = (Vec2::new(v.u, v.v), Vec2::from(v.foot));
-            assert!((foot.abs().max_element() - half).abs() < 1e-3, "the foot {foot} lies on the hard edge");
-            let d = (p - foot).length();
-            assert!(d >= v.t * r * 0.99 - 1e-4 && d <= v.t * r * 1.06 + 1e-4, "t {} at {d}", v.t);
-            assert!((Vec2::from(v.normal).length() - 1.0).abs() < 1e-5 && v.caster == 3.0);
-            match p.abs().max_element() < half - 1e-4 {
-                true => inside += 1,
-                false => outside += 1,
+        for sheet in &centred.sheets {
+            for (s, t) in [(0.1, 0.3), (0.5, 0.9), (0.8, 0.6)] {
+                let p = sheet.point(s, t);
+                let (found, foot) = sheet.at(p).unwrap();
+                let foot = Vec2::from(sheet.a).lerp(Vec2::from(sheet.b), foot);
+                assert!((foot.abs().max_element() - half).abs() < 1e-3, "the foot {foot} lies on the hard edge");
+                let d = (p - foot).length();
+                assert!(d >= found * r * 0.99 - 1e-4 && d <= found * r * 1.06 + 1e-4, "t {found} at {d}");
+                match p.abs().max_element() < half - 1e-4 {
+                    true => inside += 1,
+                    false => outside += 1,
+                }
             }
+            assert!((Vec2::from(sheet.normal).length() - 1.0).abs() < 1e-5 && sheet.caster == 3.0);
         }
         assert!(inside > 0 && outside > 0, "sheets on both sides: {inside} in, {outside} out");
     }
@@ -946,12 +1260,13 @@ mod tests {
                         assert!(g.sheets.is_empty(), "point bases: a hard edge, no sheet");
                         continue;
                     }
-                    // No twist: one flat quad, t = 0 along the hard edge and 1 along the tangent.
-                    assert_eq!(g.sheets.len(), 6, "r {r}: one quad, two triangles");
-                    for v in &g.sheets {
-                        let p = Vec2::new(v.u, v.v);
-                        let off = (p - a.centre).dot(outward);
-                        assert!((off - v.t * r).abs() < tol, "r {r}: t {} at offset {off}", v.t);
+                    // No twist: a flat quad, t = 0 along the hard edge and 1 along the tangent,
+                    // growing with the offset from it.
+                    assert_eq!(g.sheets.len(), 1, "r {r}: one sheet");
+                    for (s, t) in [(0.2, 0.1), (0.5, 0.5), (0.9, 0.95)] {
+                        let p = a.centre.lerp(b.centre, s) + outward * (t * r);
+                        let (found, _) = g.sheets[0].at(p).expect("on the sheet");
+                        assert!((found - t).abs() < tol / r.max(1e-3) + 1e-4, "r {r}: t {found} at {t} of the width");
                     }
                 }
             }

@@ -156,6 +156,14 @@ pub fn draw_vertices(
     }
 }
 
+/// Draws `count` vertices from `first` that the bound pipeline's vertex shader makes from
+/// gl_VertexIndex alone (no vertex buffer: it reads its primitives from a storage buffer).
+pub fn draw_generated(ctx: &Context, cmd: vk::CommandBuffer, first: u32, count: u32) {
+    if count > 0 {
+        unsafe { ctx.device.cmd_draw(cmd, count, 1, first, 0) };
+    }
+}
+
 /// Draws `index_count` indices of `indices` (u32) into `vertices` as instance `instance` (a
 /// mesh; the instance indexes per-object data), with the bound pipeline.
 pub fn draw_indexed(

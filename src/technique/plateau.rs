@@ -37,7 +37,13 @@
 //! shadow's outline, not along every light-facing polygon's edges (`edges = 1`), which mostly
 //! lay inside it and were probed away. The centred probes read the mask's outward side first,
 //! which decides alone on the hard shadow's boundary, and with a single caster skip the texel
-//! under the fragment.
+//! under the fragment. Each sheet and each quarter-turn piece of a wedge is one 48-byte record
+//! in a storage buffer, which the vertex shader expands (a sheet's hull, a wedge's three
+//! triangles) and whose exact t the fragment shader solves: the CPU no longer tessellates
+//! (koala, a moving frame, one thread: 5.6 ms before, 2.2 ms after, with facing from the mesh's
+//! face planes and only the edges' vertices transformed). On lavapipe the per-fragment root
+//! costs the sheets more than the vertices saved (koala 24 → 30 ms, hammer 60 → 90 ms at 512²),
+//! the wedges a little less (39 → 35 ms, 168 → 156 ms).
 //!
 //! Casters reaching the light's height: the part at or above it casts nothing (no
 //! anti-shadows): its cones and sheets are skipped, and the umbra's homogeneous clip (w =
@@ -66,14 +72,12 @@ use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
 use crate::geometry::plateau::{
-    PLATEAU_VERTEX_FLOATS, Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, PlateauVertex, ReceiverPlane,
-    plateau_sides,
+    Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
 };
 use crate::geometry::silhouette::{Caster, EdgeSource};
 use crate::gpu::{
     Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_vertices, ensure, shaders,
-    transition,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, draw_generated, ensure, shaders, transition,
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -195,8 +199,6 @@ const MASK_FORMAT: vk::Format = vk::Format::R16_UNORM;
 /// 0.87 against the ray tracer, streaks of capped cones to the horizon).
 const MAX_LIGHT_ANGLE_DEG: f64 = 60.0;
 
-const CONE_SEGMENTS: u32 = 32;
-
 /// What a caster's cached sides were built from: rebuilt only when any of it changes.
 #[derive(Clone, Debug, PartialEq)]
 struct SidesKey {
@@ -209,14 +211,16 @@ struct SidesKey {
 
 pub struct Plateau {
     umbra: Pipeline,
-    /// Side pipelines by centring and whether several casters' shadows may overlap.
-    penumbrae: Variants<(bool, bool)>,
+    /// Side pipelines by centring, whether several casters' shadows may overlap, and sheets
+    /// or wedges.
+    penumbrae: Variants<(bool, bool, bool)>,
     /// Resolve pipelines by falloff curve, off-plane mode and centring.
     resolves: Variants<(u32, bool, bool)>,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     view: PerFrame,
-    vertices: Option<PerFrame>,
+    /// The sides' primitives ([`crate::geometry::plateau::Wedge`], then `Sheet`).
+    primitives: Option<PerFrame>,
     texture: Option<Target>,
     mask: Option<Target>,
     depth: Option<Target>,
@@ -245,7 +249,7 @@ impl Plateau {
             resolves: Variants::default(),
             visibility,
             view,
-            vertices: None,
+            primitives: None,
             texture: None,
             mask: None,
             depth: None,
@@ -271,11 +275,14 @@ impl Plateau {
             if cached.as_ref().is_some_and(|(k, _)| *k == key) {
                 continue;
             }
-            let positions: Vec<_> = o.mesh.positions.iter().map(|p| model.transform_point3(*p)).collect();
-            let caster = Caster { positions: &positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
+            // In object space, as the smoothie: facing from the face planes built with the mesh,
+            // then only the edges' vertices placed in the world (issue 18).
+            let caster =
+                Caster { positions: &o.mesh.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
+            let edges = plateau_edges(&caster, &o.mesh.planes.light_facing(&model, light.position), source);
             // The umbra mask's number: the draw's instance (the object's index) plus one.
             let number = (number + 1).min(u16::MAX as usize) as f32;
-            let sides = plateau_sides(plane, &light, &caster, number, source);
+            let sides = plateau_sides(plane, &light, &caster, &model, &edges, source, number);
             *cached = Some((key, sides));
         }
     }
@@ -323,7 +330,6 @@ impl Technique for Plateau {
             radius,
             size,
             penumbra: if centred { Penumbra::Centred } else { Penumbra::Outer },
-            cone_segments: CONE_SEGMENTS,
             wedges: params.is_on(&CONES),
         };
         self.build_sides(frame, &plane, light, params);
@@ -355,12 +361,14 @@ impl Technique for Plateau {
         self.view.write(frame.slot, bytes_of(&view));
         let view_range = self.view.range(frame.slot);
 
-        let vertices: Vec<PlateauVertex> = geometry.cones.iter().chain(&geometry.sheets).copied().collect();
-        let bytes: &[u8] = cast_slice(&vertices);
-        if !bytes.is_empty() {
-            let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-            PerFrame::ensure(ctx, &mut self.vertices, "plateau sides", bytes.len() as u64, usage)?
-                .write(frame.slot, bytes);
+        // One record per primitive, wedges then sheets, of one size: the vertex shader finds
+        // its primitive from gl_VertexIndex (issue 18: 48 bytes a primitive, not a tessellation).
+        let (cones, sheets): (&[u8], &[u8]) = (cast_slice(&geometry.cones), cast_slice(&geometry.sheets));
+        if !cones.is_empty() || !sheets.is_empty() {
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            let bytes = (cones.len() + sheets.len()) as u64;
+            let buffer = PerFrame::ensure(ctx, &mut self.primitives, "plateau sides", bytes, usage)?;
+            buffer.write(frame.slot, &[cones, sheets].concat());
         }
         let cmd = frame.cmd;
         let falloff = self.falloff.texture(ctx, cmd)?;
@@ -382,18 +390,19 @@ impl Technique for Plateau {
         frame.timer.end(ctx, cmd);
 
         let overlaps = self.sides.iter().flatten().count() > 1;
-        let penumbra = self.penumbrae.get((centred, overlaps), |&(centred, overlaps)| {
-            let constants = [("CENTRED", centred as u32), ("OVERLAPS", overlaps as u32)];
-            let desc = PipelineDesc::new("penumbra", &shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG)
-                .vertex_input(VertexInput::Floats(&PLATEAU_VERTEX_FLOATS))
-                .colors(&[PLATEAU_FORMAT])
-                .blend(Blend::Min)
-                .constants(&constants);
-            Pipeline::new(ctx, &desc)
-        })?;
         let cones = geometry.cones.len() as u32;
-        let ranges = [("cones", 0, cones), ("sheets", cones, geometry.sheets.len() as u32)];
-        for (i, (name, first, count)) in ranges.into_iter().enumerate() {
+        // Per primitive, a wedge's three triangles or a sheet's two (see penumbra.vert).
+        let ranges = [("cones", false, 0, 9 * cones), ("sheets", true, 6 * cones, 6 * geometry.sheets.len() as u32)];
+        for (i, (name, sheet, first, count)) in ranges.into_iter().enumerate() {
+            let penumbra = self.penumbrae.get((centred, overlaps, sheet), |&(centred, overlaps, sheet)| {
+                let constants = [("CENTRED", centred as u32), ("OVERLAPS", overlaps as u32), ("SHEETS", sheet as u32)];
+                let (vert, frag) = (&shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG);
+                let desc = PipelineDesc::new("penumbra", vert, frag)
+                    .colors(&[PLATEAU_FORMAT])
+                    .blend(Blend::Min)
+                    .constants(&constants);
+                Pipeline::new(ctx, &desc)
+            })?;
             frame.timer.begin(ctx, cmd, name);
             // The sides read the mask; the cones' pass clears t to 1 (lit), the sheets' carries
             // on. Blended by min, channel by channel: the darkest primitive wins (§2).
@@ -404,9 +413,14 @@ impl Technique for Plateau {
                 false => Attachment { target: texture, clear: None },
             };
             let pass = RenderPass::begin(ctx, cmd, &[color], None);
-            if let Some(v) = &self.vertices {
-                penumbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Image(mask)])?;
-                draw_vertices(ctx, cmd, v.range(frame.slot), first, count);
+            if let Some(primitives) = self.primitives.as_ref().filter(|_| count > 0) {
+                let inputs = [
+                    Descriptor::Buffer(view_range),
+                    Descriptor::Image(mask),
+                    Descriptor::Buffer(primitives.range(frame.slot)),
+                ];
+                penumbra.bind(ctx, cmd, &inputs)?;
+                draw_generated(ctx, cmd, first, count);
             }
             pass.end(ctx, cmd);
             frame.timer.end(ctx, cmd);
@@ -434,7 +448,7 @@ impl Technique for Plateau {
         this.penumbrae.destroy(ctx);
         this.resolves.destroy(ctx);
         this.view.destroy(ctx);
-        this.vertices.into_iter().for_each(|b| b.destroy(ctx));
+        this.primitives.into_iter().for_each(|b| b.destroy(ctx));
         this.falloff.destroy(ctx);
         this.texture.into_iter().chain(this.mask).chain(this.depth).for_each(|t| t.destroy(ctx));
     }
