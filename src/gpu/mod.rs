@@ -30,8 +30,7 @@ pub use pipeline::{Blend, DepthState, Descriptor, Fullscreen, Pipeline, Pipeline
 pub use reflect::Binding;
 pub use render::{
     Attachment, RenderPass, copy_buffer, dispatch, draw_fullscreen, draw_generated, draw_indexed, draw_indirect,
-    draw_vertices,
-    fullscreen, update_buffer,
+    draw_vertices, fullscreen, update_buffer,
 };
 pub use swapchain::{Acquired, NativeWindow, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};
