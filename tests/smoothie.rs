@@ -286,3 +286,21 @@ fn sliver_triangles_cast_a_sane_smoothie() {
     assert!(profile.windows(2).all(|w| w[1] >= w[0] - 0.02), "{profile:?}");
     finish(e);
 }
+
+#[test]
+fn reoriented_silhouette_edges_cast_the_same_smoothies() {
+    // Linking silhouette chains (the `merge` knob) turns every edge lit side left, against how
+    // many came from the adjacency; at a millionth of a texel nothing merges on these outlines
+    // (none has exactly collinear vertices), so V must not move. It holds because an edge's
+    // alpha is its distance over its size whichever diagonal splits its quad
+    // (SmoothieVertex::w); interpolated linearly, the plate's moved by 8.5/255.
+    let mut e = engine();
+    for name in ["plate", "sphere", "torus", "default", "wingnut"] {
+        let s = suite_scene(name);
+        let every = render_with(&mut e, &s, "smoothie", &[], 128);
+        let linked = render_with(&mut e, &s, "smoothie", &[("merge", "0.000001")], 128);
+        let m = Metrics::between(&linked, &every).unwrap();
+        assert!(m.max_abs <= 1.0 / 255.0, "{name}: {m:?}");
+    }
+    finish(e);
+}

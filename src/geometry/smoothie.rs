@@ -26,6 +26,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use super::Aabb;
+use super::chains::{self, MergedEdge, PenumbraEdge};
 use super::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
@@ -52,6 +53,12 @@ pub struct SmoothieVertex {
     /// Inner quads: the caster's light-depth range; (0, 0) marks the outer smoothies.
     pub near: f32,
     pub far: f32,
+    /// Projective weight 1/t: an edge's t varies along it, so its alpha, distance over t, is
+    /// not linear across its quad, and interpolated linearly it would depend on which diagonal
+    /// splits the quad (up to 8/255 in V on the plate). Drawn with w = 1/t, the perspective-
+    /// correct interpolation of α gives Σλd / Σλt, exact for the quad's affine d and t.
+    /// Corners have one t: any constant does.
+    pub w: f32,
 }
 
 /// Which side of the hard edge the smoothies cover (the `penumbra` knob).
@@ -147,7 +154,14 @@ fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
         ny: 0.0,
         near: 0.0,
         far: 0.0,
+        w: 1.0,
     }
+}
+
+/// An edge quad's vertex: `vertex` weighted by its smoothie size `t` (see [`SmoothieVertex::w`]).
+fn weighted(v: SmoothieVertex, t: f32) -> SmoothieVertex {
+    // A zero size draws nothing; its weight must still be finite.
+    SmoothieVertex { w: if t > 0.0 && t.is_finite() { 1.0 / t } else { 1.0 }, ..v }
 }
 
 /// An inner-quad vertex at `p` belonging to the edge's point `foot`.
@@ -163,6 +177,30 @@ fn quad(out: &mut Vec<SmoothieVertex>, v: [SmoothieVertex; 4]) {
 /// meshes count as silhouettes), each with the third vertex of its light-facing triangle.
 pub fn silhouette(caster: &Caster<'_>, light: Vec3) -> Vec<([u32; 2], u32)> {
     penumbra_edges(caster, &light_facing(caster, light), EdgeSource::Silhouettes)
+}
+
+/// The silhouette `edges` (from [`silhouette`]) merged into chains that stray at most
+/// `tolerance` (tangent units of `view`) from them, in position and in smoothie reach t · k
+/// ([`chains::merge`]): on a fine mesh, whose projected outline zigzags by less than a texel,
+/// far fewer edges and corners for the same smoothies (issue 18); [`merged_smoothies`] draws
+/// them.
+pub fn merged_silhouette(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[PenumbraEdge],
+    (size, far): (SmoothieSize, f32),
+    tolerance: f32,
+) -> Vec<MergedEdge> {
+    let at = |i: u32| view.transform_point3(caster.positions[i as usize]);
+    let project = |i: u32| {
+        let p = at(i);
+        (p.z > MIN_DEPTH).then(|| Vec2::new(p.x, p.y) / p.z)
+    };
+    let width = |i: u32| {
+        let z = at(i).z;
+        size.at(z) * reach(z, far)
+    };
+    chains::merge(edges, project, width, tolerance)
 }
 
 /// One end of a projected silhouette edge at a silhouette vertex: where the vertex lies, its
@@ -181,7 +219,21 @@ struct End {
 pub fn smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
-    edges: &[([u32; 2], u32)],
+    edges: &[PenumbraEdge],
+    size: (SmoothieSize, f32),
+    penumbra: Penumbra,
+) -> SmoothieGeometry {
+    merged_smoothies(view, caster, &edges.iter().copied().map(MergedEdge::single).collect::<Vec<_>>(), size, penumbra)
+}
+
+/// [`smoothies`] of merged edges ([`merged_silhouette`]): each quad starts as far beyond its
+/// edge as the original strays the other way (outer quads `inside` of it, inner quads
+/// `outside`), so it covers the original's penumbra from where it began, alpha 0 there; the
+/// alpha then errs light outside and dark inside by at most the merge tolerance over t.
+pub fn merged_smoothies(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[MergedEdge],
     (size, far): (SmoothieSize, f32),
     penumbra: Penumbra,
 ) -> SmoothieGeometry {
@@ -191,7 +243,7 @@ pub fn smoothies(
     };
     let mut out = SmoothieGeometry::default();
     let mut ends = Vec::with_capacity(2 * edges.len());
-    for &([a, b], inner) in edges {
+    for &MergedEdge { edge: ([a, b], inner), inside, outside } in edges {
         let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
         let along = (pb - pa).try_normalize();
         // Outward: away from the light-facing triangle, across the edge.
@@ -202,28 +254,22 @@ pub fn smoothies(
         ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
         ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
         let Some(normal) = normal else { continue };
-        let (ka, kb) = (reach(za, far), reach(zb, far));
-        let (ta, tb) = (size.at(za) * ka, size.at(zb) * kb);
-        quad(
-            &mut out.edges,
-            [
-                vertex(pa, za, Vec2::ZERO),
-                vertex(pb, zb, Vec2::ZERO),
-                vertex(pb + normal * tb, zb, Vec2::X * kb),
-                vertex(pa + normal * ta, za, Vec2::X * ka),
-            ],
-        );
+        // Per end: its point, depth, reach and size; the rim lies t · k out, alpha k there.
+        let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
+        let [a, b] = ends.map(|(p, z, k, t)| {
+            let p = p - normal * inside;
+            [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)].map(|v| weighted(v, t))
+        });
+        quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
         if let Penumbra::Centred { near, far } = penumbra {
             let range = (near, far);
-            quad(
-                &mut out.inner,
-                [
-                    inner_vertex(pa, za, 0.0, (pa, normal), range),
-                    inner_vertex(pb, zb, 0.0, (pb, normal), range),
-                    inner_vertex(pb - normal * tb, zb, kb, (pb, normal), range),
-                    inner_vertex(pa - normal * ta, za, ka, (pa, normal), range),
-                ],
-            );
+            let [a, b] = ends.map(|(p, z, k, t)| {
+                let p = p + normal * outside;
+                let foot = (p, normal);
+                [inner_vertex(p, z, 0.0, foot, range), inner_vertex(p - normal * t * k, z, k, foot, range)]
+                    .map(|v| weighted(v, t))
+            });
+            quad(&mut out.inner, [a[0], b[0], b[1], a[1]]);
         }
     }
     ends.sort_unstable_by_key(|e| e.vertex);
