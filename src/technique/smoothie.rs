@@ -165,7 +165,10 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// at straight and concave turns, the inner half at convex ones), so dropping even an exactly
 /// collinear vertex changes V (open_mesh: 0.40 at any tolerance); and near contact α' = α / (1 −
 /// b/r) magnifies the depth interpolated along a merged edge (wingnut: 2.6/255 at 0.03 texels,
-/// 0.05 at 0.25). Outer only, open_mesh still moves by 6/255.
+/// 0.05 at 0.25). Outer only, open_mesh still moves by 6/255. At 1 texel (bench, 512², one
+/// run) the buffer pass takes 0.4–0.9× its unmerged time on the suite and the scale scenes, but
+/// the wingnut's penumbra, a few texels wide near contact, goes from RMSE 0.018 to 0.189: a
+/// bound in texels is too loose where the penumbra is narrow.
 const MERGE: Knob = Knob {
     name: "merge",
     default: 0.0,
