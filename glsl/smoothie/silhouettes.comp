@@ -129,9 +129,19 @@ uint arrive(uint v) {
     }
 }
 
-void corner_quad(vec2 p, float z, float t, vec2 o[4]) {
+void corner_quad(vec2 p, float z, float t, vec2 o[4], Inner inner) {
     vec2 q[4] = vec2[4](p + o[0] * t, p + o[1] * t, p + o[2] * t, p + o[3] * t);
-    quad(q, float[4](z, z, z, z), o, OUTER, float[4](1.0, 1.0, 1.0, 1.0));
+    quad(q, float[4](z, z, z, z), o, inner, float[4](1.0, 1.0, 1.0, 1.0));
+}
+
+// The sector from n0 to n1 about their bisector m, radius kk: two kites, as
+// src/geometry/smoothie.rs's wedge.
+void wedge(vec2 p, float z, float t, vec2 n0, vec2 n1, vec2 m, float kk, Inner inner) {
+    vec2 ns[2] = vec2[2](n0, n1);
+    for (int j = 0; j < 2; j++) {
+        vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
+        corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk), inner);
+    }
 }
 
 // The corner at end k of silhouette s, given the vertex's end count and its other end.
@@ -142,30 +152,29 @@ void corner(Silhouette s, int k, uint count, uint other) {
     if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
         vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
         vec2 d2 = (other & 1u) == 0u ? o.along : -o.along, n2 = o.normal;
-        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square.
+        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square;
+        // a convex turn the outer wedge, a concave one (centred) the inner wedge.
         vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
         bool consistent = dot(p1, n1) * dot(p2, n2) > 0.0;
-        bool concave = dot(n1, d2) >= 0.0;
-        if (consistent && concave && params.counts.w == 0u) {
-            return; // concave or straight: the two edges' quads overlap
-        }
         vec2 m = n1 + n2;
-        if (consistent && !concave && dot(m, m) > 0.0) {
+        if (consistent && dot(m, m) > 0.0) {
             m = normalize(m);
-            vec2 ns[2] = vec2[2](n1, n2);
-            for (int j = 0; j < 2; j++) {
-                vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
-                corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk));
-            }
-            if (params.counts.w != 0u) {
-                // Centred: the square's inner half too, as src/geometry/smoothie.rs.
-                vec2 across = vec2(-m.y, m.x) * kk;
-                corner_quad(p, z, t, vec2[4](across, across - m * kk, -across - m * kk, -across));
+            float turn = dot(n1, d2);
+            if (turn < 0.0) {
+                wedge(p, z, t, n1, n2, m, kk, OUTER);
+                if (params.counts.w != 0u) {
+                    // Centred: the square's inner half too, as src/geometry/smoothie.rs.
+                    vec2 across = vec2(-m.y, m.x) * kk;
+                    corner_quad(p, z, t, vec2[4](across, across - m * kk, -across - m * kk, -across), OUTER);
+                }
+            } else if (turn > 0.0 && params.counts.w != 0u) {
+                Inner inner = Inner(vec2[4](p, p, p, p), m, params.size.yw);
+                wedge(p, z, t, -n1, -n2, -m, kk, inner);
             }
             return;
         }
     }
-    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)));
+    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
 }
 
 void main() {
