@@ -33,6 +33,10 @@ use super::silhouette::{Caster, EdgeSource, light_facing, penumbra_edges};
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 const MIN_DEPTH: f32 = 1e-6;
 
+/// Centred, the inner half-square at a convex turn reaches at most this many times its longer
+/// edge (see [`corner`]).
+const HALF_REACH: f32 = 2.0;
+
 /// One smoothie vertex.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -212,6 +216,8 @@ struct End {
     p: Vec2,
     z: f32,
     side: Option<(Vec2, Vec2)>,
+    /// The edge's projected length.
+    length: f32,
 }
 
 /// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (the caster's
@@ -252,8 +258,8 @@ pub fn merged_smoothies(
             .zip(project(inner))
             .map(|(along, (pi, _))| if along.perp().dot(pi - pa) > 0.0 { -along.perp() } else { along.perp() });
         let side = |d: f32| along.zip(normal).map(|(along, normal)| (along * d, normal));
-        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
-        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
+        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0), length: (pb - pa).length() });
+        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0), length: (pb - pa).length() });
         let Some(normal) = normal else { continue };
         // Per end: its point, depth, reach and size; the rim lies t · k out, alpha k there.
         let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
@@ -295,16 +301,18 @@ pub fn merged_smoothies(
 /// tessellated terminator) they darken it, as the truth's area light is partly hidden there.
 /// Measured (bench, 512², lavapipe) without them: sphere penumbra RMSE 0.086 → 0.110, default
 /// 0.108 → 0.110, low_light 0.199 → 0.203, two_boxes 0.104 → 0.106, the scale scenes within
-/// 0.001, for 0.4–0.5× the smoothie buffer's time there; mirrored edge quads (at the edge's or
-/// its nearer end's depth) instead do not restore it. Any other vertex (an edge-on edge,
-/// normals on opposite sides, one or three or more edges) gets the full square of half-size t,
-/// which covers every direction outside: the §3 special case (averaging normals) is never
-/// needed, and minimum blending keeps the overlap with the edges continuous.
+/// 0.001; mirrored edge quads (at the edge's or its nearer end's depth) do not restore it. Where
+/// vertices are dense their halves cover the same band many times over, so each reaches at
+/// most [`HALF_REACH`] times its longer edge: the sphere keeps 0.086, and the halves cost
+/// the outline's length times its edges, not its vertex count times t². Any other vertex (an
+/// edge-on edge, normals on opposite sides, one or three or more edges) gets the full square
+/// of half-size t, which covers every direction outside: the §3 special case (averaging
+/// normals) is never needed, and minimum blending keeps the overlap with the edges continuous.
 fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize, f32), penumbra: Penumbra) {
     let End { p, z, .. } = group[0];
     let (t, k) = (size.at(z), reach(z, far));
     let at = |offset: Vec2| vertex(p + offset * t, z, offset);
-    if let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group {
+    if let [End { side: Some((d1, n1)), length: l1, .. }, End { side: Some((d2, n2)), length: l2, .. }] = group {
         // Both normals on the same side of the path through the vertex (in along -d1, out along
         // d2), else one was found from an edge-on triangle, whose third vertex can project to
         // either side: the square covers whichever is wrong, as it always did. Then the first
@@ -317,13 +325,21 @@ fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize,
                 _ if convex => {
                     wedge(&mut out.corners, [*n1, *n2], m, k, at);
                     if penumbra != Penumbra::Outer {
+                        let k = k.min(HALF_REACH * l1.max(*l2) / t);
                         let across = m.perp() * k;
                         quad(&mut out.corners, [at(across), at(across - m * k), at(-across - m * k), at(-across)]);
                     }
                 }
                 Penumbra::Centred { near, far: deepest } if n1.dot(*d2) > 0.0 => {
-                    let inner =
-                        |offset| SmoothieVertex { fx: p.x, fy: p.y, nx: m.x, ny: m.y, near, far: deepest, ..at(offset) };
+                    let inner = |offset| SmoothieVertex {
+                        fx: p.x,
+                        fy: p.y,
+                        nx: m.x,
+                        ny: m.y,
+                        near,
+                        far: deepest,
+                        ..at(offset)
+                    };
                     wedge(&mut out.inner, [-*n1, -*n2], -m, k, inner);
                 }
                 _ => {}
@@ -463,7 +479,8 @@ mod tests {
                 let caster = Caster { positions: &positions, triangles: &[], adjacency: &adjacency };
                 let edges = [([0, 1], 3), ([1, 2], 3)];
                 for penumbra in [Penumbra::Outer, CENTRED] {
-                    let g = smoothies(&Mat4::IDENTITY, &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), penumbra);
+                    let g =
+                        smoothies(&Mat4::IDENTITY, &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), penumbra);
                     let near = |tri: &&[SmoothieVertex]| tri.iter().all(|v| Vec2::new(v.x, v.y).length() < 2.0 * t);
                     let area = |triangles: &[SmoothieVertex]| -> f32 {
                         let area = |tri: &[SmoothieVertex]| {
@@ -485,7 +502,8 @@ mod tests {
                         (false, Penumbra::Outer) => (none, none),
                         (false, _) => (none, sector),
                     };
-                    for (area, (lo, hi), what) in [(area(&g.corners), outer, "outer"), (area(&g.inner), inner, "inner")] {
+                    for (area, (lo, hi), what) in [(area(&g.corners), outer, "outer"), (area(&g.inner), inner, "inner")]
+                    {
                         assert!(
                             (lo..=hi).contains(&area),
                             "turn {turn}, convex {convex}, {penumbra:?}: {what} area {area} not in [{lo}, {hi}]"

@@ -161,9 +161,10 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// meshes. The CPU path only: the compute path draws every silhouette edge.
 ///
 /// Off by default: V stays within 1/255 of the unmerged smoothies' on the suite (192²,
-/// lavapipe) at no tolerance above 0. Centred, every silhouette vertex draws a corner (a square
-/// at straight and concave turns, the inner half at convex ones), so dropping even an exactly
-/// collinear vertex changes V (open_mesh: 0.40 at any tolerance); and near contact α' = α / (1 −
+/// lavapipe) at no tolerance above 0. Centred, every silhouette vertex drew a corner when these
+/// were measured (a square at straight and concave turns, the inner half at convex ones; now
+/// wedges, see `geometry::smoothie`, not re-measured), so dropping even an exactly collinear
+/// vertex changed V (open_mesh: 0.40 at any tolerance); and near contact α' = α / (1 −
 /// b/r) magnifies the depth interpolated along a merged edge (wingnut: 2.6/255 at 0.03 texels,
 /// 0.05 at 0.25). Outer only, open_mesh still moves by 6/255. At 1 texel (bench, 512², one
 /// run) the buffer pass takes 0.4–0.9× its unmerged time on the suite and the scale scenes, but
