@@ -1,6 +1,7 @@
 //! Per-frame CPU cost of the smoothie's geometry on the largest shipped model (wingnut, 6090
 //! triangles, 9135 edges): silhouette extraction (face facing once per face, then every edge)
-//! and the smoothie edges and corners of one light view.
+//! and the smoothie edges and corners of one light view, of every edge and of the chains merged
+//! within one smoothie-buffer texel (`geometry::chains`).
 
 use std::hint::black_box;
 use std::path::Path;
@@ -9,7 +10,9 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::fit_spot_frustum;
 use softshadow::geometry::silhouette::Caster;
-use softshadow::geometry::smoothie::{Penumbra, SmoothieSize, silhouette, smoothies};
+use softshadow::geometry::smoothie::{
+    Penumbra, SmoothieSize, merged_silhouette, merged_smoothies, silhouette, smoothies,
+};
 use softshadow::scene::Mesh;
 
 fn smoothie(c: &mut Criterion) {
@@ -32,6 +35,15 @@ fn smoothie(c: &mut Criterion) {
     let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
     group.bench_function("smoothie geometry", |b| {
         b.iter(|| smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer))
+    });
+    // One texel of the default 1024² smoothie buffer over the light view's window.
+    let [x0, y0, x1, y1] = frustum.window;
+    let texel = (x1 - x0).max(y1 - y0) / 1024.0;
+    group.bench_function("smoothie geometry, chains merged within a texel", |b| {
+        b.iter(|| {
+            let merged = merged_silhouette(&view, black_box(&caster), &edges, size, texel);
+            merged_smoothies(&view, &caster, &merged, size, Penumbra::Outer)
+        })
     });
     group.finish();
 }

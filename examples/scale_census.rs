@@ -42,7 +42,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let h = ground.half_size;
     let receivers = [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, z)| Vec3::new(x, ground.height, z));
     println!(
-        "| caster | triangles | edges | boundary | silhouette edges | CPU ms: transform, facing+edges, plateau sides, smoothies | wedges | sheets | plateau fragments (1024²) | smoothie edge tris | corner tris | smoothie fragments |"
+        "| caster | triangles | edges | boundary | silhouette edges | CPU ms: transform, facing+edges, plateau sides, smoothies | wedges | sheets | plateau fragments (1024²) | smoothie edge tris | corner tris | smoothie fragments (edges, corners, inner quads and wedges) |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for o in scene.objects.iter().filter(|o| o.casts) {
@@ -116,8 +116,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let xy = |v: &SmoothieVertex| Vec2::new(v.x, v.y);
         let edge_fragments = area(g.edges.iter().map(xy)) * smoothie_texel;
         let corner_fragments = area(g.corners.iter().map(xy)) * smoothie_texel;
+        let inner_fragments = area(g.inner.iter().map(xy)) * smoothie_texel;
         println!(
-            "| {} | {} | {} | {} | {} ({} for the plateau) | {transform_ms:.2}, {edges_ms:.2}, {sides_ms:.2}, {smoothie_ms:.2} | {} | {} | cones {:.0} ({:.1}× the texture), sheets {:.0} | {} | {} | edges {:.0}, corners {:.0} ({:.1}× the buffer) |",
+            "| {} | {} | {} | {} | {} ({} for the plateau) | {transform_ms:.2}, {edges_ms:.2}, {sides_ms:.2}, {smoothie_ms:.2} | {} | {} | cones {:.0} ({:.1}× the texture), sheets {:.0} | {} | {} | edges {:.0}, corners {:.0}, inner {:.0} ({:.1}× the buffer) |",
             o.name,
             mesh.triangles.len(),
             mesh.adjacency.edges.len(),
@@ -133,7 +134,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             g.corners.len() / 3,
             edge_fragments,
             corner_fragments,
-            (edge_fragments + corner_fragments) / (texels * texels),
+            inner_fragments,
+            (edge_fragments + corner_fragments + inner_fragments) / (texels * texels),
         );
     }
     Ok(())

@@ -272,3 +272,79 @@ fn sliver_triangles_cast_a_sane_smoothie() {
     assert!(profile.windows(2).all(|w| w[1] >= w[0] - 0.02), "{profile:?}");
     finish(e);
 }
+
+#[test]
+fn reoriented_silhouette_edges_cast_the_same_smoothies() {
+    // Linking silhouette chains (the `merge` knob) turns every edge lit side left, against how
+    // many came from the adjacency; at a millionth of a texel nothing merges on these outlines
+    // (none has exactly collinear vertices), so V must not move. It holds because an edge's
+    // alpha is its distance over its size whichever diagonal splits its quad
+    // (SmoothieVertex::w); interpolated linearly, the plate's moved by 8.5/255.
+    let mut e = engine();
+    for name in ["plate", "sphere", "torus", "default", "wingnut"] {
+        let s = suite_scene(name);
+        let every = render_with(&mut e, &s, "smoothie", &[], 128);
+        let linked = render_with(&mut e, &s, "smoothie", &[("merge", "0.000001")], 128);
+        let m = Metrics::between(&linked, &every).unwrap();
+        assert!(m.max_abs <= 1.0 / 255.0, "{name}: {m:?}");
+    }
+    finish(e);
+}
+
+/// A closed 2 × `thickness` × 2 box whose top and bottom rims have `n` vertices per side,
+/// moved alternately `zigzag` out and in (the corners stay), as OBJ text: fans over the top and
+/// bottom, strips down the sides.
+fn tessellated_box(n: usize, zigzag: f32, thickness: f32) -> String {
+    // Counter-clockwise seen from above (+y), so the fans face out.
+    let mut rim = Vec::new();
+    for side in 0..4 {
+        for i in 0..n {
+            let s = -1.0 + 2.0 * i as f32 / n as f32;
+            let out = if i == 0 { 0.0 } else { zigzag * if i % 2 == 0 { 1.0 } else { -1.0 } };
+            let (x, z) = [(s, 1.0 + out), (1.0 + out, -s), (-s, -1.0 - out), (-1.0 - out, s)][side];
+            rim.push((x, z));
+        }
+    }
+    let m = rim.len();
+    let y = thickness / 2.0;
+    let mut obj = format!("v 0 {y} 0\nv 0 {} 0\n", -y);
+    for h in [y, -y] {
+        for (x, z) in &rim {
+            obj += &format!("v {x} {h} {z}\n");
+        }
+    }
+    let (top, bottom) = (|i: usize| 3 + i % m, |i: usize| 3 + m + i % m);
+    for i in 0..m {
+        obj += &format!("f 1 {} {}\n", top(i), top(i + 1));
+        obj += &format!("f 2 {} {}\n", bottom(i + 1), bottom(i));
+        obj += &format!("f {} {} {}\n", top(i + 1), top(i), bottom(i));
+        obj += &format!("f {} {} {}\n", top(i + 1), bottom(i), bottom(i + 1));
+    }
+    obj
+}
+
+#[test]
+fn a_finely_tessellated_outline_casts_the_coarse_one_s_shadow() {
+    // Corners cost and shade by the outline's turning, not its vertex count: the same box with
+    // four outline vertices and with 256, zigzagging by a hundredth of a pixel (tiny convex and
+    // concave turns, each with its wedge), must cast the same V, on both paths.
+    let path = |name: &str| std::env::temp_dir().join(format!("softshadow-{name}-{}.obj", std::process::id()));
+    let (coarse, fine) = (path("coarse-box"), path("fine-box"));
+    std::fs::write(&coarse, tessellated_box(1, 0.0, 0.05)).unwrap();
+    std::fs::write(&fine, tessellated_box(64, 0.0005, 0.05)).unwrap();
+    let scene = |mesh: &std::path::Path| {
+        let object =
+            format!("[[object]]\nshape = \"mesh\"\nmesh = \"{}\"\nposition = [0.3, 2.0, 0.2]\n", mesh.display());
+        lit_from(-1.0, 0.6, &object)
+    };
+    let mut e = engine();
+    for sets in [&[][..], &[("gpu_silhouettes", "1")], &[("penumbra", "0")]] {
+        let a = render_with(&mut e, &scene(&coarse), "smoothie", sets, SIZE);
+        let b = render_with(&mut e, &scene(&fine), "smoothie", sets, SIZE);
+        let m = Metrics::between(&b, &a).unwrap();
+        assert!(m.max_abs <= 2.0 / 255.0, "{sets:?}: {m:?}");
+    }
+    std::fs::remove_file(&coarse).ok();
+    std::fs::remove_file(&fine).ok();
+    finish(e);
+}

@@ -8,6 +8,7 @@ layout(local_size_x = 64) in;
 
 const uint NO_FACE = 0xffffffffu;
 const float MIN_DEPTH = 1e-6;
+const float HALF_REACH = 2.0; // src/geometry/smoothie.rs's
 
 // Smoothie size from the light's angular radius at the blocker (t = scale · R / b), or fixed.
 layout(constant_id = 0) const bool PHYSICAL_SIZE = true;
@@ -18,9 +19,9 @@ layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
 layout(std430, set = 0, binding = 5) buffer Args { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
-// x, y, b, sx, sy, fx, fy, nx, ny, near, far (src/geometry/smoothie.rs's SmoothieVertex)
+// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w (src/geometry/smoothie.rs's SmoothieVertex)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
-const uint FLOATS = 11u;
+const uint FLOATS = 12u;
 
 vec3 view_position(uint v) {
     return (params.model_view * vec4(positions[v].xyz, 1.0)).xyz;
@@ -52,15 +53,16 @@ struct Inner {
     vec2 range;
 };
 
-void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 range) {
-    float v[11] = float[11](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y);
+void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 range, float w) {
+    float v[12] = float[12](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y, w);
     for (uint k = 0u; k < FLOATS; k++) {
         vertices[FLOATS * at + k] = v[k];
     }
 }
 
-// Six vertices, two triangles: the quad q0 q1 q2 q3.
-void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner) {
+// Six vertices, two triangles: the quad q0 q1 q2 q3, with projective weights w (1/t on edges,
+// as src/geometry/smoothie.rs's SmoothieVertex::w).
+void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner, float w[4]) {
     uint at = atomicAdd(vertex_count, 6u);
     if (at + 6u > params.counts.z) {
         return; // sized so that it never happens; never write past the buffer
@@ -68,7 +70,7 @@ void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner) {
     const int order[6] = int[6](0, 1, 2, 0, 2, 3);
     for (int k = 0; k < 6; k++) {
         int o = order[k];
-        put(at + uint(k), q[o], b[o], s[o], inner.foot[o], inner.normal, inner.range);
+        put(at + uint(k), q[o], b[o], s[o], inner.foot[o], inner.normal, inner.range, w[o]);
     }
 }
 
@@ -128,9 +130,19 @@ uint arrive(uint v) {
     }
 }
 
-void corner_quad(vec2 p, float z, float t, vec2 o[4]) {
+void corner_quad(vec2 p, float z, float t, vec2 o[4], Inner inner) {
     vec2 q[4] = vec2[4](p + o[0] * t, p + o[1] * t, p + o[2] * t, p + o[3] * t);
-    quad(q, float[4](z, z, z, z), o, OUTER);
+    quad(q, float[4](z, z, z, z), o, inner, float[4](1.0, 1.0, 1.0, 1.0));
+}
+
+// The sector from n0 to n1 about their bisector m, radius kk: two kites, as
+// src/geometry/smoothie.rs's wedge.
+void wedge(vec2 p, float z, float t, vec2 n0, vec2 n1, vec2 m, float kk, Inner inner) {
+    vec2 ns[2] = vec2[2](n0, n1);
+    for (int j = 0; j < 2; j++) {
+        vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
+        corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk), inner);
+    }
 }
 
 // The corner at end k of silhouette s, given the vertex's end count and its other end.
@@ -141,30 +153,32 @@ void corner(Silhouette s, int k, uint count, uint other) {
     if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
         vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
         vec2 d2 = (other & 1u) == 0u ? o.along : -o.along, n2 = o.normal;
-        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square.
+        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square;
+        // a convex turn the outer wedge, a concave one (centred) the inner wedge.
         vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
         bool consistent = dot(p1, n1) * dot(p2, n2) > 0.0;
-        bool concave = dot(n1, d2) >= 0.0;
-        if (consistent && concave && params.counts.w == 0u) {
-            return; // concave or straight: the two edges' quads overlap
-        }
         vec2 m = n1 + n2;
-        if (consistent && !concave && dot(m, m) > 0.0) {
+        if (consistent && dot(m, m) > 0.0) {
             m = normalize(m);
-            vec2 ns[2] = vec2[2](n1, n2);
-            for (int j = 0; j < 2; j++) {
-                vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
-                corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk));
-            }
-            if (params.counts.w != 0u) {
-                // Centred: the square's inner half too, as src/geometry/smoothie.rs.
-                vec2 across = vec2(-m.y, m.x) * kk;
-                corner_quad(p, z, t, vec2[4](across, across - m * kk, -across - m * kk, -across));
+            float turn = dot(n1, d2);
+            if (turn < 0.0) {
+                wedge(p, z, t, n1, n2, m, kk, OUTER);
+                if (params.counts.w != 0u) {
+                    // Centred: the square's inner half too, at most HALF_REACH times the longer
+                    // edge, as src/geometry/smoothie.rs.
+                    float longer = max(length(s.t[1] - s.t[0]), length(o.t[1] - o.t[0]));
+                    float h = min(kk, HALF_REACH * longer / t);
+                    vec2 across = vec2(-m.y, m.x) * h;
+                    corner_quad(p, z, t, vec2[4](across, across - m * h, -across - m * h, -across), OUTER);
+                }
+            } else if (turn > 0.0 && params.counts.w != 0u) {
+                Inner inner = Inner(vec2[4](p, p, p, p), m, params.size.yw);
+                wedge(p, z, t, -n1, -n2, -m, kk, inner);
             }
             return;
         }
     }
-    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)));
+    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
 }
 
 void main() {
@@ -194,12 +208,15 @@ void main() {
     float za = s.z[0], zb = s.z[1];
     vec2 ta = s.t[0], tb = s.t[1], normal = s.normal;
     float ka = reach(za), kb = reach(zb);
-    vec2 da = normal * smoothie_t(za) * ka, db = normal * smoothie_t(zb) * kb;
+    float sa = smoothie_t(za), sb = smoothie_t(zb);
+    vec2 da = normal * sa * ka, db = normal * sb * kb;
     float b[4] = float[4](za, zb, zb, za);
     vec2 sh[4] = vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0));
-    quad(vec2[4](ta, tb, tb + db, ta + da), b, sh, OUTER);
+    float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
+    float w[4] = float[4](wa, wb, wb, wa);
+    quad(vec2[4](ta, tb, tb + db, ta + da), b, sh, OUTER, w);
     if (params.counts.w != 0u) {
         // The inner quad, mirrored over the blocker (issue 20).
-        quad(vec2[4](ta, tb, tb - db, ta - da), b, sh, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw));
+        quad(vec2[4](ta, tb, tb - db, ta - da), b, sh, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw), w);
     }
 }

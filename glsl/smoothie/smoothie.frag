@@ -15,9 +15,9 @@
 layout(set = 0, binding = 0) uniform Light { LightView light; };
 layout(set = 0, binding = 1) uniform sampler2D shadow_map;
 
-layout(location = 0) in float in_b;
-layout(location = 1) in vec2 in_shape;
-layout(location = 2) in vec2 in_probe;
+layout(location = 0) noperspective in float in_b;
+layout(location = 1) in vec2 in_shape; // perspective-correct: distance over size (smoothie.vert)
+layout(location = 2) noperspective in vec2 in_probe;
 layout(location = 3) flat in vec2 in_range;
 
 layout(location = 0) out vec4 out_smoothie;

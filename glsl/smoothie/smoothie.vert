@@ -10,10 +10,12 @@ layout(location = 1) in vec2 in_shape;         // |shape| = linear alpha
 layout(location = 2) in vec2 in_foot;          // inner quads: the edge's point, tangent coordinates
 layout(location = 3) in vec2 in_normal;        // inner quads: the edge's outward normal
 layout(location = 4) in vec2 in_range;         // inner quads: the caster's depth range; 0: outer
+layout(location = 5) in float in_w;            // projective weight 1/t: edges' alpha exact (SmoothieVertex::w)
 
-layout(location = 0) out float out_b;
+// Linear in the buffer but the alpha (`shape`), which w makes distance over size.
+layout(location = 0) noperspective out float out_b;
 layout(location = 1) out vec2 out_shape;
-layout(location = 2) out vec2 out_probe;
+layout(location = 2) noperspective out vec2 out_probe;
 layout(location = 3) flat out vec2 out_range;
 
 vec2 to_uv(vec2 tangent) {
@@ -29,5 +31,5 @@ void main() {
     vec2 texel = (light.extent.zw - light.extent.xy) / light.bias.w;
     out_probe = to_uv(in_foot + in_normal * 1.5 * max(texel.x, texel.y));
     out_range = in_range;
-    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0);
+    gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0) * in_w;
 }

@@ -3,6 +3,7 @@
 
 pub mod adjacency;
 mod bounds;
+pub mod chains;
 pub mod classic;
 mod clip;
 mod light_frustum;

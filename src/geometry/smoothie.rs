@@ -9,7 +9,7 @@
 //!
 //! Corners are the paper's wedges where two edges meet: only the gap outside a convex turn,
 //! with radial alpha; a vertex with any other number of edges gets a full square of half-size
-//! t instead, which covers every direction (see [`smoothies`]). Full squares at every vertex
+//! t instead, which covers every direction (see [`corner`]). Full squares at every vertex
 //! cost (2t)² fragments each, most of them hidden under the edges: on a finely tessellated
 //! mesh, tens of times the buffer's area (issue 18).
 //!
@@ -20,16 +20,22 @@
 //! rims of the light). Inner vertices carry what the smoothie pass needs to accept them only
 //! where the edge bounds this caster's own hard shadow (`glsl/smoothie/smoothie.frag`): the
 //! point of the edge they belong to, its outward normal and the caster's light-depth range.
-//! Inner corners are not needed: inside a convex corner the two edges' inner quads overlap, and
-//! minimum blending keeps the darker, as the outer corners' squares already cover the outside.
+//! Inside a convex corner the two edges' inner quads overlap (minimum blending keeps the
+//! shallower, lighter alpha); inside a concave one they leave a gap, which the mirror image of
+//! the outer wedge fills (see [`corner`]).
 
 use glam::{Mat4, Vec2, Vec3};
 
 use super::Aabb;
+use super::chains::{self, MergedEdge, PenumbraEdge};
 use super::silhouette::{Caster, EdgeSource, FacePlanes, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 const MIN_DEPTH: f32 = 1e-6;
+
+/// Centred, the inner half-square at a convex turn reaches at most this many times its longer
+/// edge (see [`corner`]).
+const HALF_REACH: f32 = 2.0;
 
 /// One smoothie vertex.
 #[repr(C)]
@@ -52,6 +58,12 @@ pub struct SmoothieVertex {
     /// Inner quads: the caster's light-depth range; (0, 0) marks the outer smoothies.
     pub near: f32,
     pub far: f32,
+    /// Projective weight 1/t: an edge's t varies along it, so its alpha, distance over t, is
+    /// not linear across its quad, and interpolated linearly it would depend on which diagonal
+    /// splits the quad (up to 8/255 in V on the plate). Drawn with w = 1/t, the perspective-
+    /// correct interpolation of α gives Σλd / Σλt, exact for the quad's affine d and t.
+    /// Corners have one t: any constant does.
+    pub w: f32,
 }
 
 /// Which side of the hard edge the smoothies cover (the `penumbra` knob).
@@ -147,7 +159,14 @@ fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
         ny: 0.0,
         near: 0.0,
         far: 0.0,
+        w: 1.0,
     }
+}
+
+/// An edge quad's vertex: `vertex` weighted by its smoothie size `t` (see [`SmoothieVertex::w`]).
+fn weighted(v: SmoothieVertex, t: f32) -> SmoothieVertex {
+    // A zero size draws nothing; its weight must still be finite.
+    SmoothieVertex { w: if t > 0.0 && t.is_finite() { 1.0 / t } else { 1.0 }, ..v }
 }
 
 /// An inner-quad vertex at `p` belonging to the edge's point `foot`.
@@ -166,6 +185,30 @@ pub fn silhouette(caster: &Caster<'_>, planes: &FacePlanes, model: &Mat4, light:
     penumbra_edges(caster, &planes.light_facing(model, light), EdgeSource::Silhouettes)
 }
 
+/// The silhouette `edges` (from [`silhouette`]) merged into chains that stray at most
+/// `tolerance` (tangent units of `view`) from them, in position and in smoothie reach t · k
+/// ([`chains::merge`]): on a fine mesh, whose projected outline zigzags by less than a texel,
+/// far fewer edges and corners for the same smoothies (issue 18); [`merged_smoothies`] draws
+/// them.
+pub fn merged_silhouette(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[PenumbraEdge],
+    (size, far): (SmoothieSize, f32),
+    tolerance: f32,
+) -> Vec<MergedEdge> {
+    let at = |i: u32| view.transform_point3(caster.positions[i as usize]);
+    let project = |i: u32| {
+        let p = at(i);
+        (p.z > MIN_DEPTH).then(|| Vec2::new(p.x, p.y) / p.z)
+    };
+    let width = |i: u32| {
+        let z = at(i).z;
+        size.at(z) * reach(z, far)
+    };
+    chains::merge(edges, project, width, tolerance)
+}
+
 /// One end of a projected silhouette edge at a silhouette vertex: where the vertex lies, its
 /// depth, and with the edge's direction away from the vertex and outward normal, when the edge
 /// has them (not edge-on).
@@ -174,6 +217,8 @@ struct End {
     p: Vec2,
     z: f32,
     side: Option<(Vec2, Vec2)>,
+    /// The edge's projected length.
+    length: f32,
 }
 
 /// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (the caster's
@@ -182,7 +227,21 @@ struct End {
 pub fn smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
-    edges: &[([u32; 2], u32)],
+    edges: &[PenumbraEdge],
+    size: (SmoothieSize, f32),
+    penumbra: Penumbra,
+) -> SmoothieGeometry {
+    merged_smoothies(view, caster, &edges.iter().copied().map(MergedEdge::single).collect::<Vec<_>>(), size, penumbra)
+}
+
+/// [`smoothies`] of merged edges ([`merged_silhouette`]): each quad starts as far beyond its
+/// edge as the original strays the other way (outer quads `inside` of it, inner quads
+/// `outside`), so it covers the original's penumbra from where it began, alpha 0 there; the
+/// alpha then errs light outside and dark inside by at most the merge tolerance over t.
+pub fn merged_smoothies(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[MergedEdge],
     (size, far): (SmoothieSize, f32),
     penumbra: Penumbra,
 ) -> SmoothieGeometry {
@@ -192,7 +251,7 @@ pub fn smoothies(
     };
     let mut out = SmoothieGeometry::default();
     let mut ends = Vec::with_capacity(2 * edges.len());
-    for &([a, b], inner) in edges {
+    for &MergedEdge { edge: ([a, b], inner), inside, outside } in edges {
         let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
         let along = (pb - pa).try_normalize();
         // Outward: away from the light-facing triangle, across the edge.
@@ -200,80 +259,107 @@ pub fn smoothies(
             .zip(project(inner))
             .map(|(along, (pi, _))| if along.perp().dot(pi - pa) > 0.0 { -along.perp() } else { along.perp() });
         let side = |d: f32| along.zip(normal).map(|(along, normal)| (along * d, normal));
-        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
-        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
+        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0), length: (pb - pa).length() });
+        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0), length: (pb - pa).length() });
         let Some(normal) = normal else { continue };
-        let (ka, kb) = (reach(za, far), reach(zb, far));
-        let (ta, tb) = (size.at(za) * ka, size.at(zb) * kb);
-        quad(
-            &mut out.edges,
-            [
-                vertex(pa, za, Vec2::ZERO),
-                vertex(pb, zb, Vec2::ZERO),
-                vertex(pb + normal * tb, zb, Vec2::X * kb),
-                vertex(pa + normal * ta, za, Vec2::X * ka),
-            ],
-        );
+        // Per end: its point, depth, reach and size; the rim lies t · k out, alpha k there.
+        let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
+        let [a, b] = ends.map(|(p, z, k, t)| {
+            let p = p - normal * inside;
+            [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)].map(|v| weighted(v, t))
+        });
+        quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
         if let Penumbra::Centred { near, far } = penumbra {
             let range = (near, far);
-            quad(
-                &mut out.inner,
-                [
-                    inner_vertex(pa, za, 0.0, (pa, normal), range),
-                    inner_vertex(pb, zb, 0.0, (pb, normal), range),
-                    inner_vertex(pb - normal * tb, zb, kb, (pb, normal), range),
-                    inner_vertex(pa - normal * ta, za, ka, (pa, normal), range),
-                ],
-            );
+            let [a, b] = ends.map(|(p, z, k, t)| {
+                let p = p + normal * outside;
+                let foot = (p, normal);
+                [inner_vertex(p, z, 0.0, foot, range), inner_vertex(p - normal * t * k, z, k, foot, range)]
+                    .map(|v| weighted(v, t))
+            });
+            quad(&mut out.inner, [a[0], b[0], b[1], a[1]]);
         }
     }
     ends.sort_unstable_by_key(|e| e.vertex);
     for group in ends.chunk_by(|x, y| x.vertex == y.vertex) {
-        corner(&mut out.corners, group, (size, far), matches!(penumbra, Penumbra::Centred { .. }));
+        corner(&mut out, group, (size, far), penumbra);
     }
     out
 }
 
 /// The corner at one silhouette vertex, from the ends of its edges there. Where two edges
-/// meet, only the gap their quads leave outside a convex turn needs it: the sector between the
-/// two outward normals (the paper's wedge, §3), drawn as two quads about the sector's bisector
-/// that hold its disk of radius t; a concave or straight turn needs none. Any other vertex
-/// (an edge-on edge, normals on opposite sides, three or more edges) gets the full square of half-size t, which covers
-/// every direction: the §3 special case (averaging normals) is never needed, and minimum
-/// blending keeps the overlap with the edges continuous. Centred, a convex turn's corner also
-/// keeps the square's inner half (the half disk about the vertex over the blocker) and a
-/// concave turn the whole square: the outer alpha and depth they leave over the blocker darken
-/// the inner penumbra near corners in the resolve, as the squares always did, and without them
-/// the penumbra RMSE grows (bench at 512², wedges alone: sphere 0.086 → 0.110, torus 0.051 →
-/// 0.053).
-fn corner(out: &mut Vec<SmoothieVertex>, group: &[End], (size, far): (SmoothieSize, f32), centred: bool) {
+/// meet, only the gap their quads leave needs it: outside a convex turn, the sector between the
+/// two outward normals (the paper's wedge, §3), radial alpha from the vertex; a concave or
+/// straight turn needs none there (the two quads overlap). Centred, a concave turn leaves the
+/// mirror-image gap over the blocker, between the inner quads, and gets the mirror-image wedge:
+/// radial inner alpha, accepted as the inner quads are, probing along the outward bisector. A
+/// wedge's area is 2·tan(θ/4)·t² for a turn of θ, so these cost the outline's total turning,
+/// not its vertex count: the squares they replace (the whole square at concave turns, centred)
+/// were most of the buffer's fragments on fine meshes, whose silhouettes zigzag (issue 18).
+///
+/// Centred, a convex turn still keeps the square's inner half, outer alpha and depth over the
+/// blocker: where the caster's own surface lies behind the vertex's depth (the facets along a
+/// tessellated terminator) they darken it, as the truth's area light is partly hidden there.
+/// Measured (bench, 512², lavapipe) without them: sphere penumbra RMSE 0.086 → 0.110, default
+/// 0.108 → 0.110, low_light 0.199 → 0.203, two_boxes 0.104 → 0.106, the scale scenes within
+/// 0.001; mirrored edge quads (at the edge's or its nearer end's depth) do not restore it. Where
+/// vertices are dense their halves cover the same band many times over, so each reaches at
+/// most [`HALF_REACH`] times its longer edge: the sphere keeps 0.086, and the halves cost
+/// the outline's length times its edges, not its vertex count times t². Any other vertex (an
+/// edge-on edge, normals on opposite sides, one or three or more edges) gets the full square
+/// of half-size t, which covers every direction outside: the §3 special case (averaging
+/// normals) is never needed, and minimum blending keeps the overlap with the edges continuous.
+fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize, f32), penumbra: Penumbra) {
     let End { p, z, .. } = group[0];
     let (t, k) = (size.at(z), reach(z, far));
     let at = |offset: Vec2| vertex(p + offset * t, z, offset);
-    if let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group {
+    if let [End { side: Some((d1, n1)), length: l1, .. }, End { side: Some((d2, n2)), length: l2, .. }] = group {
         // Both normals on the same side of the path through the vertex (in along -d1, out along
         // d2), else one was found from an edge-on triangle, whose third vertex can project to
         // either side: the square covers whichever is wrong, as it always did. Then the first
-        // normal against the second edge's direction: a convex turn leaves a gap, a concave or
-        // straight one none (the two quads overlap).
+        // normal against the second edge's direction: a convex turn leaves a gap outside, a
+        // concave one inside.
         let consistent = (-*d1).perp().dot(*n1) * d2.perp().dot(*n2) > 0.0;
-        if consistent && n1.dot(*d2) >= 0.0 && !centred {
-            return;
-        }
-        if let Some(m) = (*n1 + *n2).try_normalize().filter(|_| consistent && n1.dot(*d2) < 0.0) {
-            for n in [*n1, *n2] {
-                let tip = (n + m) / (1.0 + n.dot(m)); // where the disk's tangents at n and m meet
-                quad(out, [at(Vec2::ZERO), at(n * k), at(tip * k), at(m * k)]);
-            }
-            if centred {
-                let across = m.perp() * k;
-                quad(out, [at(across), at(across - m * k), at(-across - m * k), at(-across)]);
+        if let Some(m) = (*n1 + *n2).try_normalize().filter(|_| consistent) {
+            let convex = n1.dot(*d2) < 0.0;
+            match penumbra {
+                _ if convex => {
+                    wedge(&mut out.corners, [*n1, *n2], m, k, at);
+                    if penumbra != Penumbra::Outer {
+                        let k = k.min(HALF_REACH * l1.max(*l2) / t);
+                        let across = m.perp() * k;
+                        quad(&mut out.corners, [at(across), at(across - m * k), at(-across - m * k), at(-across)]);
+                    }
+                }
+                Penumbra::Centred { near, far: deepest } if n1.dot(*d2) > 0.0 => {
+                    let inner = |offset| SmoothieVertex {
+                        fx: p.x,
+                        fy: p.y,
+                        nx: m.x,
+                        ny: m.y,
+                        near,
+                        far: deepest,
+                        ..at(offset)
+                    };
+                    wedge(&mut out.inner, [-*n1, -*n2], -m, k, inner);
+                }
+                _ => {}
             }
             return;
         }
     }
     let c = |sx: f32, sy: f32| at(Vec2::new(sx, sy) * k);
-    quad(out, [c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0)]);
+    quad(&mut out.corners, [c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0)]);
+}
+
+/// The sector from direction `n[0]` to `n[1]` about their bisector `m`, of radius `k` in shape
+/// units (`at` makes a vertex from a shape offset): two quads, each the kite of the disk's
+/// tangents at one side and at the bisector, which hold the disk's sector.
+fn wedge(out: &mut Vec<SmoothieVertex>, n: [Vec2; 2], m: Vec2, k: f32, at: impl Fn(Vec2) -> SmoothieVertex) {
+    for n in n {
+        let tip = (n + m) / (1.0 + n.dot(m)); // where the disk's tangents at n and m meet
+        quad(out, [at(Vec2::ZERO), at(n * k), at(tip * k), at(m * k)]);
+    }
 }
 
 #[cfg(test)]
@@ -339,7 +425,10 @@ mod tests {
     fn inside(tri: &[SmoothieVertex], q: Vec2) -> bool {
         let [a, b, c] = [0, 1, 2].map(|i| Vec2::new(tri[i].x, tri[i].y));
         let w = [(b - a).perp_dot(q - a), (c - b).perp_dot(q - b), (a - c).perp_dot(q - c)];
-        w.iter().all(|w| *w >= -1e-9) || w.iter().all(|w| *w <= 1e-9)
+        // Rounding, relative to the triangle's size: a point on the diagonal two triangles
+        // share must count for one of them.
+        let eps = 1e-6 * [a, b, c].map(|p| (p - q).length_squared()).iter().fold(0.0f32, |m, d| m.max(*d));
+        w.iter().all(|w| *w >= -eps) || w.iter().all(|w| *w <= eps)
     }
 
     #[test]
@@ -372,6 +461,58 @@ mod tests {
         // A third edge at (0, 0) and a loose end: full squares there.
         edges.push(([0, 7], 6));
         assert_eq!(corners(&edges), [(-1, -1, 6), (0, 0, 6), (0, 2, 12), (1, 2, 12), (2, 0, 12), (2, 1, 12)]);
+    }
+
+    #[test]
+    fn a_corner_costs_its_turn_not_a_square_at_concave_and_outer_turns() {
+        // Two edges meeting at the origin, turning left by θ, the light-facing side on the left
+        // (a convex turn) or the right (concave), at depth 5; their far ends lie 1 away, beyond
+        // the squares there. The triangles within 2t of the origin are the corner's.
+        let t = 0.01;
+        for i in 1..32 {
+            let turn = i as f32 / 32.0 * std::f32::consts::PI;
+            let (into, out) = (Vec2::X, Vec2::from_angle(turn));
+            for (side, convex) in [(1.0, true), (-1.0, false)] {
+                let inside = (out - into) * 0.5 * side;
+                let points = [-into, Vec2::ZERO, out, inside];
+                let positions: Vec<Vec3> = points.iter().map(|p| p.extend(1.0) * 5.0).collect();
+                let adjacency = EdgeAdjacency::default();
+                let caster = Caster { positions: &positions, triangles: &[], adjacency: &adjacency };
+                let edges = [([0, 1], 3), ([1, 2], 3)];
+                for penumbra in [Penumbra::Outer, CENTRED] {
+                    let g =
+                        smoothies(&Mat4::IDENTITY, &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), penumbra);
+                    let near = |tri: &&[SmoothieVertex]| tri.iter().all(|v| Vec2::new(v.x, v.y).length() < 2.0 * t);
+                    let area = |triangles: &[SmoothieVertex]| -> f32 {
+                        let area = |tri: &[SmoothieVertex]| {
+                            let [a, b, c] = [0, 1, 2].map(|k| Vec2::new(tri[k].x, tri[k].y));
+                            (b - a).perp_dot(c - a).abs() * 0.5
+                        };
+                        triangles.chunks(3).filter(near).map(area).sum()
+                    };
+                    // The gap is the sector of θ, area θt²/2, outside a convex turn, over the
+                    // blocker inside a concave one (centred); two kites hold it, 2·tan(θ/4)·t².
+                    // Centred, a convex turn also keeps the square's inner half, 2t² (see
+                    // `corner`): the one part that does not follow the turn.
+                    let sector = (0.5 * turn * t * t * 0.999, turn * t * t);
+                    let half = 2.0 * t * t;
+                    let none = (0.0, 0.0);
+                    let (outer, inner) = match (convex, penumbra) {
+                        (true, Penumbra::Outer) => (sector, none),
+                        (true, _) => ((sector.0 + half, sector.1 + half * 1.001), none),
+                        (false, Penumbra::Outer) => (none, none),
+                        (false, _) => (none, sector),
+                    };
+                    for (area, (lo, hi), what) in [(area(&g.corners), outer, "outer"), (area(&g.inner), inner, "inner")]
+                    {
+                        assert!(
+                            (lo..=hi).contains(&area),
+                            "turn {turn}, convex {convex}, {penumbra:?}: {what} area {area} not in [{lo}, {hi}]"
+                        );
+                    }
+                }
+            }
+        }
     }
 
     /// Any depth range: only the shaders read it.

@@ -29,6 +29,10 @@
 //! the fragment is that caster (its depth inside the caster's range): one caster's inner half
 //! never lightens what another blocks, and interior silhouettes (folds) stay umbra.
 //!
+//! Cost (issue 18): `merge` links each caster's silhouette into chains and simplifies them
+//! (`geometry::chains`) before the smoothies are made, on the CPU path only (the compute path,
+//! `gpu_silhouettes`, draws every edge); off by default, see [`MERGE`].
+//!
 //! Deviations: the smoothie buffer has no depth target. Minimum blending of b gives the nearest
 //! smoothie in any order, which a depth test would only give for the depth, not for the alpha
 //! that the paper also minimum-blends. The inner half is remapped in the resolve, with the
@@ -49,7 +53,10 @@ use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::Aabb;
 use crate::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
-use crate::geometry::smoothie::{Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, smoothies};
+use crate::geometry::smoothie::{
+    Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette, merged_smoothies,
+    smoothies,
+};
 use crate::gpu::{
     Access, Attachment, Blend, Context, Descriptor, Fullscreen, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
     Target, TargetDesc, Variants, VertexInput, draw_indirect, draw_vertices, ensure, shaders, transition,
@@ -68,10 +75,18 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         SMOOTHIE_FALLOFF,
         DEPTH16,
         GPU_SILHOUETTES,
+        MERGE,
         SHADOW_MESH_ERROR,
     ],
     create: |ctx, _, visibility| Ok(Box::new(Smoothie::new(ctx, visibility)?)),
-    bench: &[&[], OUTER_ONLY, &[("depth16", "1")], &[("gpu_silhouettes", "1")], &[("shadow_mesh_error", "1")]],
+    bench: &[
+        &[],
+        OUTER_ONLY,
+        &[("depth16", "1")],
+        &[("gpu_silhouettes", "1")],
+        &[("shadow_mesh_error", "1")],
+        &[("merge", "1")],
+    ],
     sweep_knobs: SweepKnobs::DEFAULTS,
     // Issue 5: the smoothie's map is 1024² by default, so against the hard map at 1024².
     cost_goal: Some(CostGoal {
@@ -139,7 +154,30 @@ const GPU_SILHOUETTES: Knob = Knob {
     min: 0.0,
     max: 1.0,
     integer: true,
-    help: "1: silhouettes and smoothies in a compute shader, drawn indirectly; 0: on the CPU",
+    help: "1: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); 0: on the CPU",
+};
+
+/// Silhouette chains merged before the smoothies are made (`geometry::chains`), within this
+/// many smoothie-buffer texels in position and in reach: fewer edges and corners on fine
+/// meshes. The CPU path only: the compute path draws every silhouette edge.
+///
+/// Off by default: V stays within 1/255 of the unmerged smoothies' on the suite (192²,
+/// lavapipe) at no tolerance above 0. Centred, every silhouette vertex drew a corner when these
+/// were measured (a square at straight and concave turns, the inner half at convex ones; now
+/// wedges, see `geometry::smoothie`, not re-measured), so dropping even an exactly collinear
+/// vertex changed V (open_mesh: 0.40 at any tolerance); and near contact α' = α / (1 −
+/// b/r) magnifies the depth interpolated along a merged edge (wingnut: 2.6/255 at 0.03 texels,
+/// 0.05 at 0.25). Outer only, open_mesh still moves by 6/255. At 1 texel (bench, 512², one
+/// run) the buffer pass takes 0.4–0.9× its unmerged time on the suite and the scale scenes, but
+/// the wingnut's penumbra, a few texels wide near contact, goes from RMSE 0.018 to 0.189: a
+/// bound in texels is too loose where the penumbra is narrow.
+const MERGE: Knob = Knob {
+    name: "merge",
+    default: 0.0,
+    min: 0.0,
+    max: 16.0,
+    integer: false,
+    help: "CPU path: merge silhouette chains within this many smoothie-buffer texels (position and size); 0: off",
 };
 
 const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
@@ -207,7 +245,7 @@ impl Smoothie {
         params: &Params,
         view: &Mat4,
         (size, far): (SmoothieSize, f32),
-        centred: bool,
+        (centred, tolerance): (bool, f32),
     ) -> SmoothieGeometry {
         let objects = &frame.scene.objects;
         let light = frame.scene.light.position;
@@ -234,7 +272,12 @@ impl Smoothie {
             let c = cached.as_ref().expect("set above");
             let view = *view * model;
             let penumbra = penumbra(centred, &view, &o.mesh.bounds);
-            out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra));
+            if tolerance > 0.0 {
+                let merged = merged_silhouette(&view, &caster, &c.edges, (size, far), tolerance);
+                out.extend(&merged_smoothies(&view, &caster, &merged, (size, far), penumbra));
+            } else {
+                out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra));
+            }
         }
         out
     }
@@ -285,7 +328,11 @@ impl Technique for Smoothie {
             let (vertices, args) = gpu.record(frame, params, &frustum.view, (smoothie_size, frustum.far), centred)?;
             Smoothies::Indirect { vertices, args }
         } else {
-            let geometry = self.geometry(frame, params, &frustum.view, (smoothie_size, frustum.far), centred);
+            // The merge bound in tangent units: texels of the smoothie buffer over the window.
+            let [x0, y0, x1, y1] = frustum.window;
+            let tolerance = params.get(&MERGE) as f32 * (x1 - x0).max(y1 - y0) / buffer_size as f32;
+            let geometry =
+                self.geometry(frame, params, &frustum.view, (smoothie_size, frustum.far), (centred, tolerance));
             let vertices: Vec<SmoothieVertex> = geometry.vertices().copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
             if bytes.is_empty() {
@@ -307,7 +354,7 @@ impl Technique for Smoothie {
                 &shaders::SMOOTHIE_SMOOTHIE_VERT,
                 &shaders::SMOOTHIE_SMOOTHIE_FRAG,
             )
-            .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2]))
+            .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1]))
             .colors(&formats)
             .blend(Blend::Min);
             Pipeline::new(ctx, &desc)
