@@ -33,6 +33,7 @@ struct LightView {
     vec4 kernel;     // PCF: taps, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
                      // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
                      // smoothie: buffer size, an empty map texel's depth, ground height, light height
+    vec4 depths;     // the frustum's linear depth range: near, far, log2(far / near), 0
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the
@@ -41,7 +42,7 @@ struct LightSample {
     LightView view;
     vec4 position;   // xyz; w = 1 with a shadow map, 0 when nothing in view can block it
     vec4 normal;     // xyz the sphere's outward normal there (0: a point light); w its weight
-    vec4 pad[3];
+    vec4 pad[2];
 };
 
 // The plateau texture's frame (Haines): the receiver plane, in-plane axes, the window.

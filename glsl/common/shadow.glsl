@@ -55,17 +55,33 @@ ShadowLookup shadow_lookup(LightView light, vec3 from, vec3 p, vec3 n) {
     return s;
 }
 
-// The four texels nearest `uv`, compared with `depth` (1 = lit) and bilinearly weighted. The
-// map is the size x size tile at texel `origin` of `atlas`; the footprint stays inside it.
-float compare_bilinear(sampler2D atlas, vec2 origin, float size, vec2 uv, float depth) {
+// The four texels nearest `uv` in the size x size map at texel `origin` of `atlas` (the
+// footprint stays inside it): their depths in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0), and
+// the bilinear weights.
+struct MapTexels {
+    vec4 d;
+    vec2 f;
+};
+
+MapTexels map_texels(sampler2D atlas, vec2 origin, float size, vec2 uv) {
     vec2 texel_pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
-    vec2 f = fract(texel_pos);
-    // Gathering at the corner shared by the four texels: (i0,j1) (i1,j1) (i1,j0) (i0,j0).
-    vec4 d = textureGather(atlas, (origin + floor(texel_pos) + 1.0) / vec2(textureSize(atlas, 0)), 0);
-    vec4 lit = vec4(greaterThanEqual(d, vec4(depth)));
-    float top = mix(lit.w, lit.z, f.x);
-    float bottom = mix(lit.x, lit.y, f.x);
-    return mix(top, bottom, f.y);
+    // Gathering at the corner shared by the four texels.
+    vec2 corner = (origin + floor(texel_pos) + 1.0) / vec2(textureSize(atlas, 0));
+    return MapTexels(textureGather(atlas, corner, 0), fract(texel_pos));
+}
+
+// Four values in gather order, bilinearly weighted.
+float bilinear(vec2 f, vec4 v) {
+    return mix(mix(v.w, v.z, f.x), mix(v.x, v.y, f.x), f.y);
+}
+
+// The four texels compared with `depth` (1 = lit), bilinearly weighted.
+float lit_bilinear(MapTexels m, float depth) {
+    return bilinear(m.f, vec4(greaterThanEqual(m.d, vec4(depth))));
+}
+
+float compare_bilinear(sampler2D atlas, vec2 origin, float size, vec2 uv, float depth) {
+    return lit_bilinear(map_texels(atlas, origin, size, uv), depth);
 }
 
 // The receiver's tangent plane in light view space, for lookups whose footprint is wide enough
@@ -114,9 +130,7 @@ float compare_bilinear_plane(sampler2D map, LightView light, ReceiverPlane r, ve
     vec4 d = textureGather(map, (i0 + 1.0) / vec2(textureSize(map, 0)), 0);
     vec4 lit = vec4(!in_front_of(light, r, i0 + vec2(0.0, 1.0), d.x), !in_front_of(light, r, i0 + vec2(1.0, 1.0), d.y),
                     !in_front_of(light, r, i0 + vec2(1.0, 0.0), d.z), !in_front_of(light, r, i0, d.w));
-    float top = mix(lit.w, lit.z, f.x);
-    float bottom = mix(lit.x, lit.y, f.x);
-    return mix(top, bottom, f.y);
+    return bilinear(f, lit);
 }
 
 #endif

@@ -117,15 +117,16 @@ void main() {
     }
     vec2 probe = PROBE * normalize(across);
     uint here = OVERLAPS ? caster_at(gl_FragCoord.xy) : 0u;
+    // Both probes, read once for either case: llvmpipe runs both branches below.
+    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
     if (here == 0u || here == in_caster) {
-        // Outward first: on the hard shadow's boundary it is lit, and one read decides.
-        if (caster_at(foot + probe) != 0u && caster_at(foot - probe) != 0u) {
+        // On the hard shadow's boundary one side is lit.
+        if (a != 0u && b != 0u) {
             discard;
         }
         out_t = in_channel(in_caster, t);
         return;
     }
-    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
     // Over another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
     // something other than its own caster across it.
     bool outer_half = in_normal != vec2(0.0) && dot(from_foot, in_normal * size) > 0.0;

@@ -8,84 +8,116 @@
 #include "camera.glsl"
 #include "shadow.glsl"
 #include "falloff.glsl"
+#include "depth.glsl"
 
 layout(constant_id = 0) const bool CENTRED = false;
+// The smoothie buffer's texels are the shadow map's (equal sizes over one frustum).
+layout(constant_id = 1) const bool SAME_GRID = true;
+// The resolve's two draws (smoothie.rs): MASK writes V where no smoothie is near, where V is
+// the hard test, and discards the rest, which the second draw, with its depth test, shades
+// alone. llvmpipe runs every branch of a fragment shader, so without the mask every pixel paid
+// for the smoothie fetches; a GPU skips them too, but only in whole warps.
+layout(constant_id = 2) const bool MASK = false;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Light { LightView light; };
 layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D shadow_map;
-layout(set = 0, binding = 5) uniform sampler2D smoothies; // b, α'; centred: also α and −b inside
+layout(set = 0, binding = 5) uniform sampler2D smoothies; // b, α'; centred: also α, 1 − b inside (depth.glsl codes)
 layout(set = 0, binding = 6) uniform sampler2D falloff;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
-// The four smoothie texels around a lookup, in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0).
+// The four smoothie texels around a lookup, in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0),
+// each fetched whole: llvmpipe runs every branch of a fragment shader, so one fetch of all
+// channels costs less than a gather per channel.
 struct Texels {
-    vec2 base;    // texel (i0, j0)
-    vec2 corner;  // where to gather them
+    ivec2 base;   // texel (i0, j0)
     vec2 f;       // bilinear weights
-    vec4 b;       // the outer smoothies' depths
+    vec4 b;       // the outer smoothies' depth codes
+    vec4 outer;   // their remapped alpha α'
+    vec4 inner;   // the inner quads' alpha α, 1 (umbra) where none (centred only)
+    vec4 inner_b; // their depth codes (centred only)
     vec4 behind;  // 1 where the receiver lies behind the texel's outer smoothie
 };
 
-Texels texels(vec2 uv, float depth) {
-    Texels t;
+const ivec2 GATHER_ORDER[4] = ivec2[4](ivec2(0, 1), ivec2(1, 1), ivec2(1, 0), ivec2(0, 0));
+
+// Where a lookup falls in the smoothie buffer, in texels from texel (0, 0)'s centre.
+vec2 smoothie_pos(vec2 uv) {
     float size = light.kernel.x;
-    vec2 pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
-    t.base = floor(pos);
-    t.corner = (t.base + 1.0) / size;
-    t.f = fract(pos);
-    t.b = textureGather(smoothies, t.corner, 0);
-    t.behind = vec4(greaterThan(vec4(depth), t.b));
-    return t;
+    return clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
 }
 
-float bilinear(Texels t, vec4 v) {
-    return mix(mix(v.w, v.z, t.f.x), mix(v.x, v.y, t.f.x), t.f.y);
+Texels texels(vec2 uv, float depth) {
+    float code = depth_code(light, depth);
+    Texels t;
+    vec2 pos = smoothie_pos(uv);
+    t.base = ivec2(pos);
+    t.f = fract(pos);
+    for (int k = 0; k < 4; k++) {
+        vec4 texel = texelFetch(smoothies, t.base + GATHER_ORDER[k], 0);
+        t.b[k] = texel.x;
+        t.outer[k] = texel.y;
+        t.inner[k] = texel.z;
+        t.inner_b[k] = 1.0 - texel.w;
+    }
+    t.behind = vec4(greaterThan(vec4(code), t.b));
+    return t;
 }
 
 // The paper's smoothie test: α' where the receiver lies behind a smoothie, else 1.
 float outer_test(vec2 uv, float depth) {
     Texels t = texels(uv, depth);
-    if (t.behind == vec4(0.0)) {
-        return 1.0; // behind no smoothie: most of the frame, spared the alpha fetch
-    }
-    return bilinear(t, mix(vec4(1.0), textureGather(smoothies, t.corner, 1), t.behind));
+    return bilinear(t.f, mix(vec4(1.0), t.outer, t.behind));
 }
 
 // Centred V: the penumbra parameter, 0 umbra .. ½ hard edge .. 1 lit, through the falloff;
 // `umbra`, the hard test, where no smoothie is near (exactly the hard shadow for a point light).
-float centred_test(vec2 uv, float depth, float umbra) {
+// `map`: the shadow map's texels around the lookup, which are the smoothie texels' own where
+// the two grids agree (SAME_GRID).
+float centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     Texels t = texels(uv, depth);
-    vec4 inner_alpha = textureGather(smoothies, t.corner, 2); // α, or 2 where no inner quad
-    vec4 inner = vec4(lessThanEqual(inner_alpha, vec4(1.0)));
-    if (t.behind == vec4(0.0) && inner == vec4(0.0)) {
+    if (t.behind == vec4(0.0) && t.inner == vec4(1.0)) {
         return umbra;
     }
-    vec4 outer = mix(vec4(1.0), textureGather(smoothies, t.corner, 1), t.behind);
     // Equation 1 for the inner half, r the receiver's depth (contact, b ≥ r: hard).
-    vec4 b = -textureGather(smoothies, t.corner, 3);
-    vec4 a = clamp(inner_alpha / max(1.0 - min(b / depth, vec4(1.0)), 1e-6), 0.0, 1.0);
+    vec4 a = clamp(t.inner / max(1.0 - min(code_depth(light, t.inner_b) / depth, vec4(1.0)), 1e-6), 0.0, 1.0);
     // The map at each smoothie texel's centre: is the receiver behind a caster there?
-    float map_size = light.bias.w, size = light.kernel.x;
-    ivec2 last = ivec2(map_size - 1.0);
-    const vec2 offsets[4] = vec2[4](vec2(0, 1), vec2(1, 1), vec2(1, 0), vec2(0, 0));
-    vec4 caster;
-    for (int k = 0; k < 4; k++) {
-        vec2 centre = (t.base + offsets[k] + 0.5) / size;
-        caster[k] = texelFetch(shadow_map, min(ivec2(centre * map_size), last), 0).r;
+    vec4 caster = map.d;
+    float map_size = light.bias.w;
+    if (!SAME_GRID) {
+        ivec2 last = ivec2(map_size - 1.0);
+        for (int k = 0; k < 4; k++) {
+            vec2 centre = (vec2(t.base + GATHER_ORDER[k]) + 0.5) / light.kernel.x;
+            caster[k] = texelFetch(shadow_map, min(ivec2(centre * map_size), last), 0).r;
+        }
     }
     // Lit: the outer half. Shadowed: only an inner half lightens it, darkened by the outer
     // penumbra of a caster in front of the map's (blockers taken as independent, which errs
     // dark; the caster's own outer smoothies, at its depth, are no other blocker).
+    vec4 outer = mix(vec4(1.0), t.outer, t.behind);
     vec4 lit = 0.5 + 0.5 * outer;
     float slack = 2.0 * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / map_size;
-    vec4 in_front = t.behind * vec4(lessThan(t.b, caster * (1.0 - slack)));
-    vec4 shadowed = inner * (0.5 - 0.5 * a) * mix(vec4(1.0), lit, in_front);
-    return falloff_at(falloff, FALLOFF, bilinear(t, mix(lit, shadowed, vec4(lessThan(caster, vec4(depth))))));
+    vec4 in_front = t.behind * vec4(lessThan(t.b, depth_code(light, caster * (1.0 - slack))));
+    vec4 shadowed = (0.5 - 0.5 * a) * mix(vec4(1.0), lit, in_front);
+    return falloff_at(falloff, FALLOFF, bilinear(t.f, mix(lit, shadowed, vec4(lessThan(caster, vec4(depth))))));
+}
+
+// Whether V at this lookup can differ from the hard test's: an alpha below 1 among the four
+// smoothie texels (an outer α' of 1 is lit, an inner α of 1 umbra), or the hard test's own
+// bilinear edge (0 < umbra < 1), which the falloff shapes.
+bool near_smoothie(vec2 uv, float umbra) {
+    vec2 corner = (floor(smoothie_pos(uv)) + 1.0) / light.kernel.x;
+    vec4 alpha = textureGather(smoothies, corner, 1);
+    if (CENTRED) {
+        alpha = min(alpha, textureGather(smoothies, corner, 2));
+    } else if (umbra == 0.0) {
+        return false; // outer only: the map's umbra stays umbra
+    }
+    return (umbra > 0.0 && umbra < 1.0) || any(lessThan(alpha, vec4(1.0)));
 }
 
 void main() {
@@ -109,11 +141,19 @@ void main() {
         out_visibility = self_lit;
         return;
     }
-    float umbra = compare_bilinear(shadow_map, vec2(0.0), light.bias.w, l.uv, l.depth);
+    MapTexels map = map_texels(shadow_map, vec2(0.0), light.bias.w, l.uv);
+    float umbra = lit_bilinear(map, l.depth);
+    if (MASK) {
+        if (near_smoothie(l.uv, umbra)) {
+            discard; // the penumbra draw's
+        }
+        out_visibility = min(self_lit, umbra);
+        return;
+    }
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
     // falloff texture.
     if (CENTRED) {
-        out_visibility = min(self_lit, centred_test(l.uv, l.depth, umbra));
+        out_visibility = min(self_lit, centred_test(l.uv, l.depth, umbra, map));
         return;
     }
     float v = umbra > 0.0 ? min(umbra, outer_test(l.uv, l.depth)) : 0.0;

@@ -1,16 +1,18 @@
 #version 460
 // The smoothie buffer in one pass and one target (the paper's multiple-render-target remark,
-// §4, packed): depth b and remapped alpha α' (Equation 1) of the outer smoothies, and with
-// inner quads (issue 20) α and −b of those, all composited with minimum blending, so the
-// nearest smoothie depth and the minimum alpha (Parker's thresholding, §3.1), the shallowest
-// inner alpha and the farthest inner depth come out in any drawing order. Each kind writes the
-// other's channels at their clear values, which minimum blending leaves as they are.
+// §4, packed): depth b (its code, depth.glsl) and remapped alpha α' (Equation 1) of the outer
+// smoothies, and with inner quads (issue 20) α and 1 − code(b) of those, all composited with
+// minimum blending, so the nearest smoothie depth and the minimum alpha (Parker's
+// thresholding, §3.1), the shallowest inner alpha and the farthest inner depth come out in any
+// drawing order. Every channel clears to 1, and each kind writes the other's channels at 1,
+// which minimum blending leaves as they are; an inner alpha of 1 is umbra, as no inner quad.
 //
 // The shallowest inner alpha is the lightest: over a blocker, the truth at a convex corner is
 // lighter than either edge's half plane alone (the blocker is their intersection), the
 // opposite of the outside, where the darkest wins. Inner quads of other casters never meet
 // here: the acceptance test below keeps each to its own caster's texels.
 #include "interface.glsl"
+#include "depth.glsl"
 
 layout(set = 0, binding = 0) uniform Light { LightView light; };
 layout(set = 0, binding = 1) uniform sampler2D shadow_map;
@@ -21,9 +23,6 @@ layout(location = 2) noperspective in vec2 in_probe;
 layout(location = 3) flat in vec2 in_range;
 
 layout(location = 0) out vec4 out_smoothie;
-
-const float NO_DEPTH = 3.402823466e38; // the clear values: EMPTY_DEPTH
-const float NO_INNER = 2.0;           // and an inner alpha beyond any
 
 // Depth along this texel's ray where it meets the ground plane (kernel.z: its height, kernel.w:
 // the light's), infinite when it does not: view-space rays (x/z, y/z, 1) advance one unit of
@@ -54,7 +53,7 @@ void main() {
         if (!own || map_at(in_probe) < light.kernel.y) {
             discard;
         }
-        out_smoothie = vec4(NO_DEPTH, 1.0, alpha, -in_b);
+        out_smoothie = vec4(1.0, 1.0, alpha, 1.0 - depth_code(light, in_b));
         return;
     }
     // Equation 1 with r, the nearest surface behind this texel (Figure 11 reads it from the
@@ -63,5 +62,5 @@ void main() {
     if (f >= 1.0) {
         discard; // behind a blocker: hidden from the light
     }
-    out_smoothie = vec4(in_b, clamp(alpha / (1.0 - f), 0.0, 1.0), NO_INNER, 0.0);
+    out_smoothie = vec4(depth_code(light, in_b), clamp(alpha / (1.0 - f), 0.0, 1.0), 1.0, 1.0);
 }

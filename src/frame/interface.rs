@@ -37,6 +37,8 @@ pub struct LightView {
     pub extent: Vec4,
     pub bias: Vec4,
     pub kernel: Vec4,
+    /// The frustum's linear depth range: near, far, log2(far / near), 0.
+    pub depths: Vec4,
 }
 
 /// One point sampled on the area light, with the view its shadow map was rendered through.
@@ -51,7 +53,7 @@ pub struct LightSample {
     /// xyz the light sphere's outward normal at the point (0 for a point light); w its
     /// importance weight (`geometry::LightPoint`).
     pub normal: Vec4,
-    pub pad: [Vec4; 3],
+    pub pad: [Vec4; 2],
 }
 
 /// The plateau texture's frame: the receiver plane and the window of it the texture covers.
@@ -143,7 +145,7 @@ pub struct CasterImage {
 
 const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
-const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 3 * 16);
+const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 4 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
 const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
 const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);

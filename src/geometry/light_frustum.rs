@@ -9,7 +9,7 @@
 //! casters that matter out of the frustum. What one frustum cannot hold (a light among its
 //! casters) is reported by caster, never dropped silently.
 
-use glam::{DMat4, DVec3, DVec4, Mat4, Vec3};
+use glam::{DMat4, DVec3, DVec4, Mat4, Vec3, Vec4};
 
 use super::Aabb;
 
@@ -260,6 +260,11 @@ impl LightFrustum {
     /// moved to along its direction (`light_scale` < 1). Depths are distances from it.
     pub fn centre(&self) -> Vec3 {
         self.view.inverse().transform_point3(Vec3::ZERO)
+    }
+
+    /// `LightView::depths`: near, far, log2(far / near), 0.
+    pub fn depths(&self) -> Vec4 {
+        Vec4::new(self.near, self.far, (self.far / self.near).log2(), 0.0)
     }
 
     /// The same frustum with its window grown by `pad` tangent units on every side (geometry

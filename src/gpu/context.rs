@@ -433,6 +433,15 @@ impl Context {
         self.depth_stencil_format
     }
 
+    /// Whether optimally tiled images of `format` can be sampled and blended into as colour
+    /// attachments: beyond the formats Vulkan requires, a device may lack them.
+    pub fn renders_blended(&self, format: vk::Format) -> bool {
+        let needed = vk::FormatFeatureFlags::SAMPLED_IMAGE | vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND;
+        unsafe { self.instance.get_physical_device_format_properties(self.physical, format) }
+            .optimal_tiling_features
+            .contains(needed)
+    }
+
     /// Validation errors recorded so far: empty when validation is off, and always for a context
     /// [`from_handles`](Context::from_handles), whose messages go to the embedder's messenger.
     pub fn validation_errors(&self) -> Vec<String> {

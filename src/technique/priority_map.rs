@@ -132,6 +132,7 @@ impl Technique for PriorityMap {
             extent: Vec4::from(frustum.window),
             bias: Vec4::new(0.0, 0.0, 0.0, size as f32),
             kernel: Vec4::ZERO,
+            depths: frustum.depths(),
         };
         self.light.write(frame.slot, bytes_of(&view));
         let light = self.light.range(frame.slot);

@@ -124,13 +124,14 @@ impl Reference {
                     extent: Vec4::from(f.window),
                     bias: Vec4::from((Vec3::from(DEFAULT_BIASES), size as f32)),
                     kernel: Vec4::ZERO,
+                    depths: f.depths(),
                 });
                 let has_map = if frustum.is_some() { 1.0 } else { 0.0 };
                 LightSample {
                     view,
                     position: q.extend(has_map),
                     normal: point.normal.extend(point.weight),
-                    pad: [Vec4::ZERO; 3],
+                    pad: [Vec4::ZERO; 2],
                 }
             })
             .collect();

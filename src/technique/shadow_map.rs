@@ -252,6 +252,7 @@ impl ShadowMapPass {
             extent: Vec4::from(frustum.window),
             bias: Vec4::new(bias[0], bias[1], bias[2], size as f32),
             kernel: filter,
+            depths: frustum.depths(),
         };
         self.light.write(frame.slot, bytes_of(&view));
         let (map, depth) = (self.map.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));

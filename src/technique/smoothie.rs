@@ -4,8 +4,9 @@
 //! Passes, in the paper's order: `shadow_map` (pass 1, the shared [`ShadowMapPass`], linear depth
 //! in R32F or the paper's 16-bit float), `smoothie_buffer` (the smoothie edges and corners drawn
 //! from the light into depth b and remapped alpha α' = α / (1 − b/r) at once, packed in one
-//! RG32F target with minimum blending), `resolve` (the two depth comparisons at the four nearest
-//! texels, then the falloff).
+//! 16-bit two-channel target with minimum blending, b as a logarithmic code: see
+//! [`smoothie_format`]), `resolve` (the two depth comparisons at the four nearest texels, then
+//! the falloff).
 //!
 //! r, the receiver's distance behind a smoothie texel, is the nearer of the casters' depth in
 //! the map (as Figure 11 reads it) and the ground plane's along the texel's ray, computed
@@ -18,7 +19,7 @@
 //! Penumbra (issue 20, the `penumbra` knob): the paper's smoothies grow outward only, so the
 //! whole hard shadow stays umbra and a physical size only darkens (§3). Centred, each edge also
 //! gets an inner quad over its blocker (`geometry::smoothie`), drawn into two more channels of
-//! the smoothie buffer (RGBA32F: α and −b, minimum-blended too: the shallowest inner alpha, as
+//! the smoothie buffer (α and 1 − b, minimum-blended too: the shallowest inner alpha, as
 //! the blocker is the intersection of its edges' half planes, and the farthest inner depth,
 //! which errs dark), the resolve maps the distance over the whole
 //! width, t = ½ ± ½α' on the lit and the shadowed side, through the
@@ -48,7 +49,7 @@ use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, S
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
 use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_caster};
 use super::smoothie_gpu::GpuSilhouettes;
-use super::{Technique, clear_visibility, resolve, surface_inputs};
+use super::{Technique, clear_visibility, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::Aabb;
@@ -58,8 +59,9 @@ use crate::geometry::smoothie::{
     smoothies,
 };
 use crate::gpu::{
-    Access, Attachment, Blend, Context, Descriptor, Fullscreen, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
-    Target, TargetDesc, Variants, VertexInput, draw_indirect, draw_vertices, ensure, shaders, transition,
+    Access, Attachment, Blend, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
+    Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices, ensure, shaders,
+    transition,
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -181,13 +183,106 @@ const MERGE: Knob = Knob {
 };
 
 const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+/// The resolve's penumbra mask: only 0 and 1 are ever in it.
+const MASK_FORMAT: vk::Format = vk::Format::D16_UNORM;
 /// The largest finite 16-bit float.
 const HALF_MAX: f32 = 65504.0;
-/// The smoothie buffer: depth b and remapped alpha α' of the outer smoothies; centred, also α
-/// and −b of the inner quads (minimum blending keeps the shallowest inner alpha, the farthest
-/// inner depth).
-fn smoothie_format(centred: bool) -> vk::Format {
-    if centred { vk::Format::R32G32B32A32_SFLOAT } else { vk::Format::R32G32_SFLOAT }
+/// The smoothie buffer: depth b (as a code in [0, 1], glsl/smoothie/depth.glsl) and remapped
+/// alpha α' of the outer smoothies; centred, also α and 1 − b of the inner quads (minimum
+/// blending keeps the shallowest inner alpha, the farthest inner depth). Unsigned normalized
+/// 16-bit channels where the device blends into them (Vulkan does not require it), else 32-bit
+/// floats holding the same codes.
+fn smoothie_format(ctx: &Context, centred: bool) -> vk::Format {
+    let (unorm, float) = if centred {
+        (vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT)
+    } else {
+        (vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)
+    };
+    if ctx.renders_blended(unorm) { unorm } else { float }
+}
+
+/// A resolve pipeline's specialization: falloff curve, centred, same grid.
+type ResolveKey = (u32, bool, bool);
+
+/// The resolve's two draws' pipelines and the target between them.
+#[derive(Default)]
+struct MaskedResolve {
+    masks: Variants<ResolveKey>,
+    penumbrae: Variants<ResolveKey>,
+    /// Which pixels the mask draw left to the penumbra draw.
+    mask: Option<Target>,
+}
+
+impl MaskedResolve {
+    /// The resolve in two draws into V: the mask draw shades every pixel with the hard test and
+    /// the self-shadowing, and discards those near a smoothie, which keep the mask target's
+    /// cleared depth; the penumbra draw, depth-tested against it, shades only those. Each pixel
+    /// is written once, by one of them; the pass is timed as one.
+    fn record(
+        &mut self,
+        frame: &mut FrameInputs<'_>,
+        format: vk::Format,
+        key: ResolveKey,
+        visibility: &mut Target,
+        inputs: &[Descriptor<'_>],
+    ) -> Result<()> {
+        let (ctx, cmd) = (frame.ctx, frame.cmd);
+        let pipeline = |mask: bool, depth: DepthState| {
+            move |&(curve, centred, same_grid): &ResolveKey| {
+                let constants = [
+                    ("FALLOFF", curve),
+                    ("CENTRED", u32::from(centred)),
+                    ("SAME_GRID", u32::from(same_grid)),
+                    ("MASK", u32::from(mask)),
+                ];
+                let formats = [format];
+                let desc =
+                    PipelineDesc::new("resolve", &shaders::COMMON_FULLSCREEN_VERT, &shaders::SMOOTHIE_RESOLVE_FRAG)
+                        .colors(&formats)
+                        .depth(depth)
+                        .constants(&constants);
+                Pipeline::new(ctx, &desc)
+            }
+        };
+        // The full-screen triangle lies at depth 0: the mask draw writes 0 where it shades, the
+        // penumbra draw passes where the clear's 1 is left.
+        let mask_pipeline =
+            self.masks.get(key, pipeline(true, DepthState::test_write(MASK_FORMAT, vk::CompareOp::ALWAYS)))?;
+        let penumbra_pipeline =
+            self.penumbrae.get(key, pipeline(false, DepthState::test_only(MASK_FORMAT, vk::CompareOp::LESS)))?;
+        let extent = visibility.extent();
+        ensure(
+            ctx,
+            &mut self.mask,
+            TargetDesc { format: MASK_FORMAT, ..TargetDesc::depth("penumbra mask", extent.width, extent.height) },
+        )?;
+        let mask = self.mask.as_mut().expect("ensured");
+        frame.timer.begin(ctx, cmd, "resolve");
+        transition(ctx, cmd, &mut [(visibility, Access::COLOR_WRITE, true), (mask, Access::DEPTH_WRITE, true)]);
+        let pass = RenderPass::begin(
+            ctx,
+            cmd,
+            &[Attachment { target: visibility, clear: None }],
+            Some(Attachment::clear_depth(mask, 1.0)),
+        );
+        let mut bound = mask_pipeline.bind(ctx, cmd, inputs);
+        if bound.is_ok() {
+            draw_fullscreen(ctx, cmd);
+            bound = penumbra_pipeline.bind(ctx, cmd, inputs);
+            if bound.is_ok() {
+                draw_fullscreen(ctx, cmd);
+            }
+        }
+        pass.end(ctx, cmd);
+        frame.timer.end(ctx, cmd);
+        bound
+    }
+
+    fn destroy(self, ctx: &Context) {
+        self.masks.destroy(ctx);
+        self.penumbrae.destroy(ctx);
+        self.mask.into_iter().for_each(|t| t.destroy(ctx));
+    }
 }
 
 /// What a caster's silhouette was found from: recomputed only when it changes.
@@ -208,8 +303,9 @@ pub struct Smoothie {
     pass: ShadowMapPass,
     /// The smoothie pass, by centring (the buffer's format).
     smoothie: Variants<bool>,
-    /// Resolve pipelines by falloff curve and centring.
-    resolves: Variants<(u32, bool)>,
+    /// The smoothie buffer's format, outer only and centred.
+    buffer_formats: [vk::Format; 2],
+    resolve: MaskedResolve,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     vertices: Option<PerFrame>,
@@ -227,7 +323,8 @@ impl Smoothie {
         Ok(Smoothie {
             pass: pass.keep(),
             smoothie: Variants::default(),
-            resolves: Variants::default(),
+            buffer_formats: [smoothie_format(ctx, false), smoothie_format(ctx, true)],
+            resolve: MaskedResolve::default(),
             visibility,
             vertices: None,
             buffer: None,
@@ -345,7 +442,7 @@ impl Technique for Smoothie {
             }
         };
 
-        let buffer_format = smoothie_format(centred);
+        let buffer_format = self.buffer_formats[usize::from(centred)];
         ensure(ctx, &mut self.buffer, TargetDesc::color("smoothie buffer", buffer_format, buffer_size, buffer_size))?;
         let smoothie = self.smoothie.get(centred, |_| {
             let formats = [buffer_format];
@@ -366,8 +463,9 @@ impl Technique for Smoothie {
 
         frame.timer.begin(ctx, cmd, "smoothie_buffer");
         transition(ctx, cmd, &mut [(buffer, Access::COLOR_WRITE, true)]);
-        // What minimum blending leaves where no smoothie is: no depth, alpha 1, no inner quad (2).
-        let pass = RenderPass::begin(ctx, cmd, &[Attachment::clear_color(buffer, [EMPTY_DEPTH, 1.0, 2.0, 0.0])], None);
+        // What minimum blending leaves where no smoothie is: the farthest depth code, alpha 1, and
+        // an inner alpha of 1 (umbra, as no inner quad).
+        let pass = RenderPass::begin(ctx, cmd, &[Attachment::clear_color(buffer, [1.0; 4])], None);
         smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)])?;
         match source {
             Smoothies::Direct { vertices, count } => draw_vertices(ctx, cmd, vertices, 0, count),
@@ -384,20 +482,16 @@ impl Technique for Smoothie {
             &[Descriptor::Image(map), Descriptor::Image(buffer), Descriptor::Image(falloff)],
         ]
         .concat();
-        let format = self.visibility;
-        let pipeline = self.resolves.get((params.get(&SMOOTHIE_FALLOFF) as u32, centred), |&(curve, centred)| {
-            let constants = [("FALLOFF", curve), ("CENTRED", centred as u32)];
-            let desc = Fullscreen::new("resolve", &shaders::SMOOTHIE_RESOLVE_FRAG, format).constants(&constants);
-            Pipeline::fullscreen(ctx, &desc)
-        })?;
-        resolve(frame, pipeline, visibility, &inputs)
+        // One frustum for both: equal sizes put the buffer's texels on the map's.
+        let key = (params.get(&SMOOTHIE_FALLOFF) as u32, centred, buffer_size == size);
+        self.resolve.record(frame, self.visibility, key, visibility, &inputs)
     }
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         let this = *self;
         this.pass.destroy(ctx);
         this.smoothie.destroy(ctx);
-        this.resolves.destroy(ctx);
+        this.resolve.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
         this.buffer.into_iter().for_each(|t| t.destroy(ctx));
         this.falloff.destroy(ctx);

@@ -1,0 +1,27 @@
+// The smoothie buffer's depths (b of the outer smoothies and of the inner quads) as codes in
+// [0, 1]: log2(b / near) over log2(far / near), for 16-bit unsigned normalized channels. The
+// paper keeps these depths in a depth buffer and alpha in a fixed-point one (§4); here one
+// target holds both at half the bytes of 32-bit floats, which on lavapipe is most of the
+// smoothie pass (its clear) and a quarter of the resolve's fetches. Every depth of the frustum
+// gets the same relative precision, ln(far / near) / 65535 ≤ 1.4e-4 (near ≥ far·1e-4), finer
+// than a half float's 4.9e-4, and the code is monotonic: minimum blending and the resolve's
+// depth comparisons work on codes directly.
+#ifndef SOFTSHADOW_SMOOTHIE_DEPTH_GLSL
+#define SOFTSHADOW_SMOOTHIE_DEPTH_GLSL
+#include "interface.glsl"
+
+// 0 at (and before) near, 1 at far and beyond: an empty texel's code, behind any receiver.
+float depth_code(LightView light, float depth) {
+    return clamp(log2(depth / light.depths.x) / light.depths.z, 0.0, 1.0);
+}
+
+vec4 depth_code(LightView light, vec4 depth) {
+    return clamp(log2(depth / light.depths.x) / light.depths.z, 0.0, 1.0);
+}
+
+// The depths codes stand for.
+vec4 code_depth(LightView light, vec4 code) {
+    return light.depths.x * exp2(code * light.depths.z);
+}
+
+#endif
