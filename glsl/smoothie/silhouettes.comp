@@ -8,7 +8,6 @@ layout(local_size_x = 64) in;
 
 const uint NO_FACE = 0xffffffffu;
 const float MIN_DEPTH = 1e-6;
-const float HALF_REACH = 2.0; // src/geometry/smoothie.rs's
 
 // Smoothie size from the light's angular radius at the blocker (t = scale · R / b), or fixed.
 layout(constant_id = 0) const bool PHYSICAL_SIZE = true;
@@ -163,14 +162,6 @@ void corner(Silhouette s, int k, uint count, uint other) {
             float turn = dot(n1, d2);
             if (turn < 0.0) {
                 wedge(p, z, t, n1, n2, m, kk, OUTER);
-                if (params.counts.w != 0u) {
-                    // Centred: the square's inner half too, at most HALF_REACH times the longer
-                    // edge, as src/geometry/smoothie.rs.
-                    float longer = max(length(s.t[1] - s.t[0]), length(o.t[1] - o.t[0]));
-                    float h = min(kk, HALF_REACH * longer / t);
-                    vec2 across = vec2(-m.y, m.x) * h;
-                    corner_quad(p, z, t, vec2[4](across, across - m * h, -across - m * h, -across), OUTER);
-                }
             } else if (turn > 0.0 && params.counts.w != 0u) {
                 Inner inner = Inner(vec2[4](p, p, p, p), m, params.size.yw);
                 wedge(p, z, t, -n1, -n2, -m, kk, inner);

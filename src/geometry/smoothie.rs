@@ -33,10 +33,6 @@ use super::silhouette::{Caster, EdgeSource, FacePlanes, penumbra_edges};
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 const MIN_DEPTH: f32 = 1e-6;
 
-/// Centred, the inner half-square at a convex turn reaches at most this many times its longer
-/// edge (see [`corner`]).
-const HALF_REACH: f32 = 2.0;
-
 /// One smoothie vertex.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -217,8 +213,6 @@ struct End {
     p: Vec2,
     z: f32,
     side: Option<(Vec2, Vec2)>,
-    /// The edge's projected length.
-    length: f32,
 }
 
 /// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (the caster's
@@ -259,8 +253,8 @@ pub fn merged_smoothies(
             .zip(project(inner))
             .map(|(along, (pi, _))| if along.perp().dot(pi - pa) > 0.0 { -along.perp() } else { along.perp() });
         let side = |d: f32| along.zip(normal).map(|(along, normal)| (along * d, normal));
-        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0), length: (pb - pa).length() });
-        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0), length: (pb - pa).length() });
+        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
+        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
         let Some(normal) = normal else { continue };
         // Per end: its point, depth, reach and size; the rim lies t · k out, alpha k there.
         let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
@@ -297,15 +291,13 @@ pub fn merged_smoothies(
 /// not its vertex count: the squares they replace (the whole square at concave turns, centred)
 /// were most of the buffer's fragments on fine meshes, whose silhouettes zigzag (issue 18).
 ///
-/// Centred, a convex turn still keeps the square's inner half, outer alpha and depth over the
-/// blocker: where the caster's own surface lies behind the vertex's depth (the facets along a
-/// tessellated terminator) they darken it, as the truth's area light is partly hidden there.
-/// Measured (bench, 512², lavapipe) without them: sphere penumbra RMSE 0.086 → 0.110, default
-/// 0.108 → 0.110, low_light 0.199 → 0.203, two_boxes 0.104 → 0.106, the scale scenes within
-/// 0.001; mirrored edge quads (at the edge's or its nearer end's depth) do not restore it. Where
-/// vertices are dense their halves cover the same band many times over, so each reaches at
-/// most [`HALF_REACH`] times its longer edge: the sphere keeps 0.086, and the halves cost
-/// the outline's length times its edges, not its vertex count times t². Any other vertex (an
+/// Centred, a convex turn needs nothing over the blocker, where its two inner quads overlap. It
+/// used to keep the square's inner half of outer smoothie there, which darkened the tessellated
+/// terminator (sphere 0.110 → 0.086) until the resolve took a caster's own surface as lit by
+/// the light above its tangent plane; since then the halves only darkened it twice. Without
+/// them (bench, 512², lavapipe, one run): sphere penumbra RMSE 0.0295 → 0.0156, low_light 0.0274
+/// → 0.0254, no scene worse, and the smoothie pass 0.6–0.97× as long (sphere 5.2 → 2.7 ms,
+/// default 7.3 → 5.4). Any other vertex (an
 /// edge-on edge, normals on opposite sides, one or three or more edges) gets the full square
 /// of half-size t, which covers every direction outside: the §3 special case (averaging
 /// normals) is never needed, and minimum blending keeps the overlap with the edges continuous.
@@ -313,7 +305,7 @@ fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize,
     let End { p, z, .. } = group[0];
     let (t, k) = (size.at(z), reach(z, far));
     let at = |offset: Vec2| vertex(p + offset * t, z, offset);
-    if let [End { side: Some((d1, n1)), length: l1, .. }, End { side: Some((d2, n2)), length: l2, .. }] = group {
+    if let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group {
         // Both normals on the same side of the path through the vertex (in along -d1, out along
         // d2), else one was found from an edge-on triangle, whose third vertex can project to
         // either side: the square covers whichever is wrong, as it always did. Then the first
@@ -323,14 +315,7 @@ fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize,
         if let Some(m) = (*n1 + *n2).try_normalize().filter(|_| consistent) {
             let convex = n1.dot(*d2) < 0.0;
             match penumbra {
-                _ if convex => {
-                    wedge(&mut out.corners, [*n1, *n2], m, k, at);
-                    if penumbra != Penumbra::Outer {
-                        let k = k.min(HALF_REACH * l1.max(*l2) / t);
-                        let across = m.perp() * k;
-                        quad(&mut out.corners, [at(across), at(across - m * k), at(-across - m * k), at(-across)]);
-                    }
-                }
+                _ if convex => wedge(&mut out.corners, [*n1, *n2], m, k, at),
                 Penumbra::Centred { near, far: deepest } if n1.dot(*d2) > 0.0 => {
                     let inner = |offset| SmoothieVertex {
                         fx: p.x,
@@ -492,14 +477,10 @@ mod tests {
                     };
                     // The gap is the sector of θ, area θt²/2, outside a convex turn, over the
                     // blocker inside a concave one (centred); two kites hold it, 2·tan(θ/4)·t².
-                    // Centred, a convex turn also keeps the square's inner half, 2t² (see
-                    // `corner`): the one part that does not follow the turn.
                     let sector = (0.5 * turn * t * t * 0.999, turn * t * t);
-                    let half = 2.0 * t * t;
                     let none = (0.0, 0.0);
                     let (outer, inner) = match (convex, penumbra) {
-                        (true, Penumbra::Outer) => (sector, none),
-                        (true, _) => ((sector.0 + half, sector.1 + half * 1.001), none),
+                        (true, _) => (sector, none),
                         (false, Penumbra::Outer) => (none, none),
                         (false, _) => (none, sector),
                     };
@@ -527,7 +508,7 @@ mod tests {
             let size = (SmoothieSize::Fixed(t), f32::INFINITY);
             let g = smoothies(&down(), &caster, &edges, size, CENTRED);
             prop_assert_eq!(g.inner.len(), 4 * 6, "one inner quad per silhouette edge");
-            prop_assert_eq!(g.corners.len(), 4 * 18, "centred, each wedge keeps the square's inner half");
+            prop_assert_eq!(g.corners.len(), 4 * 12, "a wedge at each convex vertex, nothing over the blocker");
             let half = 0.5 / (10.0 - height);
             for v in &g.inner {
                 let (p, foot, normal) = (Vec2::new(v.x, v.y), Vec2::new(v.fx, v.fy), Vec2::new(v.nx, v.ny));
