@@ -80,6 +80,21 @@ fn the_simplified_shadow_mesh_stays_within_its_stated_error() {
     assert!(Arc::ptr_eq(&o.mesh.shadow_mesh(0.0), &o.mesh));
 }
 
+/// Where the simplifier leaves a closed mesh with a non-manifold edge (the 100k-triangle knot at
+/// 2⁻⁹), a smaller error still gives a closed copy with far fewer triangles, not the full mesh.
+#[test]
+fn a_simplification_that_opens_the_mesh_falls_back_to_a_finer_one() {
+    let knot = Arc::new(primitives::knot(100_000).unwrap());
+    let simple = knot.shadow_mesh(2f32.powi(-9));
+    assert!(simple.adjacency.is_closed());
+    assert!(
+        simple.triangles.len() * 2 < knot.triangles.len(),
+        "{} of {} triangles",
+        simple.triangles.len(),
+        knot.triangles.len()
+    );
+}
+
 /// The smoothie's compute path (`gpu_silhouettes = 1`) casts from the simplified mesh as its CPU
 /// path does: the same smoothies from it, and not the full mesh's.
 #[test]
