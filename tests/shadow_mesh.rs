@@ -108,9 +108,32 @@ fn the_smoothies_compute_path_casts_from_the_shadow_mesh_too() {
     let gpu = [simple[0], ("gpu_silhouettes", "1")];
     let cpu = render_with(&mut e, &s, "smoothie", &simple, 128);
     let on_gpu = render_with(&mut e, &s, "smoothie", &gpu, 128);
-    let full = render_with(&mut e, &s, "smoothie", &[("gpu_silhouettes", "1")], 128);
+    let full = render_with(&mut e, &s, "smoothie", &[("gpu_silhouettes", "1"), ("shadow_mesh_error", "0")], 128);
     let same = Metrics::between(&on_gpu, &cpu).unwrap().max_abs;
     let apart = Metrics::between(&full, &cpu).unwrap().max_abs;
     assert!(same < 0.01 && apart > 10.0 * same.max(1e-3), "GPU vs CPU {same}, full vs simplified {apart}");
+    finish(e);
+}
+
+/// The plateau draws its umbra from the shadow mesh its sides come from: on the ground, its
+/// shadow is the one the simplified caster itself casts, not a mix of the two meshes.
+#[test]
+fn the_plateaus_umbra_is_cast_from_the_shadow_mesh_too() {
+    use common::{engine, finish, render_with, top_down};
+    use softshadow::measure::Metrics;
+    // Receiving nothing itself: only the ground's V, where the shadow falls, is compared.
+    let knot =
+        "[[object]]\nshape = \"knot\"\ntriangles = 20000\nposition = [0.0, 1.0, 0.0]\nscale = 0.8\nreceives = false\n";
+    let s = top_down(0.0, 2.0, LIGHT.to_array(), 0.3, knot);
+    let world = texels_at_caster(&s.objects[0], LIGHT, 4.0).expect("the light is outside the caster");
+    let mut simplified = s.clone();
+    simplified.objects[0].mesh = s.objects[0].mesh.shadow_mesh(world / 0.8);
+    let mut e = engine();
+    let cast = render_with(&mut e, &s, "plateau", &[("shadow_mesh_error", "4")], 128);
+    let by_itself = render_with(&mut e, &simplified, "plateau", &[("shadow_mesh_error", "0")], 128);
+    let full = render_with(&mut e, &s, "plateau", &[("shadow_mesh_error", "0")], 128);
+    let same = Metrics::between(&cast, &by_itself).unwrap().max_abs;
+    let apart = Metrics::between(&full, &cast).unwrap().max_abs;
+    assert!(same < 0.01 && apart > 10.0 * same.max(1e-3), "shadow mesh vs itself {same}, full vs simplified {apart}");
     finish(e);
 }

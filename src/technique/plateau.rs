@@ -58,6 +58,8 @@
 //! the sphere 0.110 → 0.016, low_light 0.206 → 0.046). Off the plane, shadows of other casters
 //! are still missing (two_boxes' box 2 under box 1, overlap's low plate: most of their error).
 
+use std::sync::Arc;
+
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec2, Vec4};
@@ -66,7 +68,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_caster};
+use super::shadow_mesh::{SOFT_SHADOW_MESH_ERROR, shadow_caster, shadow_mesh};
 use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
@@ -76,9 +78,11 @@ use crate::geometry::plateau::{
 };
 use crate::geometry::silhouette::{Caster, EdgeSource};
 use crate::gpu::{
-    Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, draw_generated, ensure, shaders, transition,
+    Access, Attachment, Blend, Buffer, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Uploads, Variants, draw_generated, draw_indexed, ensure,
+    shaders, transition, upload,
 };
+use crate::scene::{Mesh, MeshId};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "plateau",
@@ -94,7 +98,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         EDGES,
         CONES,
         OFF_PLANE,
-        SHADOW_MESH_ERROR,
+        SOFT_SHADOW_MESH_ERROR,
     ],
     create: |ctx, _, visibility| Ok(Box::new(Plateau::new(ctx, visibility)?)),
     bench: &[
@@ -103,7 +107,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         OUTER_ONLY_NARROW,
         WHOLE_CONES,
         &[("texture_size", "512")],
-        &[("shadow_mesh_error", "1")],
+        &[("shadow_mesh_error", "0")],
     ],
     sweep_knobs: SweepKnobs::DEFAULTS,
     // Issue 4: plateaus against the hard map at the same screen size.
@@ -227,6 +231,37 @@ pub struct Plateau {
     falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
     sides: Vec<Option<(SidesKey, PlateauGeometry)>>,
+    /// The simplified shadow meshes the umbra pass draws (`shadow_mesh_error`).
+    shadow_meshes: Uploads<MeshId, ShadowMeshBuffers>,
+}
+
+/// A shadow mesh's vertices and indices, as the frame's own meshes are drawn.
+struct ShadowMeshBuffers {
+    vertices: Buffer,
+    indices: Buffer,
+    count: u32,
+}
+
+impl ShadowMeshBuffers {
+    /// Uploads recorded into `cmd`.
+    fn new(ctx: &Context, cmd: vk::CommandBuffer, mesh: &Mesh) -> Result<Self> {
+        let (vertices, indices) = mesh.render_geometry();
+        let vertex_buffer = upload(ctx, cmd, &mesh.name, cast_slice(&vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        match upload(ctx, cmd, &mesh.name, cast_slice(&indices), vk::BufferUsageFlags::INDEX_BUFFER) {
+            Ok(index_buffer) => {
+                Ok(ShadowMeshBuffers { vertices: vertex_buffer, indices: index_buffer, count: indices.len() as u32 })
+            }
+            Err(e) => {
+                vertex_buffer.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy(self, ctx: &Context) {
+        self.vertices.destroy(ctx);
+        self.indices.destroy(ctx);
+    }
 }
 
 impl Plateau {
@@ -255,6 +290,7 @@ impl Plateau {
             depth: None,
             falloff: Falloff::default(),
             sides: Vec::new(),
+            shadow_meshes: Uploads::new(ShadowMeshBuffers::destroy),
         })
     }
 
@@ -373,6 +409,22 @@ impl Technique for Plateau {
         let cmd = frame.cmd;
         let falloff = self.falloff.texture(ctx, cmd)?;
 
+        // The umbra is the casters' hard shadow: drawn from the meshes the sides came from, the
+        // simplified shadow meshes where `shadow_mesh_error` asks for them (their uploads recorded
+        // before the pass), else the frame's own.
+        let mut umbra_draws = Vec::new();
+        for draw in frame.draws.iter().filter(|d| d.casts) {
+            // A draw's instance is its object's index in the scene.
+            let object = frame.scene.objects.get(draw.instance as usize);
+            let mesh = object.map(|o| (shadow_mesh(o, light.position, params), &o.mesh));
+            let uploaded = match mesh {
+                Some((mesh, own)) if !Arc::ptr_eq(&mesh, own) => {
+                    Some(self.shadow_meshes.index(ctx, mesh.id(), || ShadowMeshBuffers::new(ctx, cmd, &mesh))?)
+                }
+                _ => None,
+            };
+            umbra_draws.push((draw, uploaded));
+        }
         let texture = self.texture.as_mut().expect("ensured");
         let (mask, depth) = (self.mask.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));
         // umbra: the mask cleared to 0 (no caster), then the flattened casters, the lowest nearest.
@@ -385,7 +437,12 @@ impl Technique for Plateau {
             Some(Attachment::clear_depth(depth, 1.0)),
         );
         self.umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)])?;
-        super::shadow_map::draw_casters(frame);
+        for (draw, uploaded) in umbra_draws {
+            match uploaded.map(|i| self.shadow_meshes.get(i)) {
+                Some(m) => draw_indexed(ctx, cmd, m.vertices.buffer, m.indices.buffer, m.count, draw.instance),
+                None => draw.record(ctx, cmd),
+            }
+        }
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
@@ -450,6 +507,7 @@ impl Technique for Plateau {
         this.view.destroy(ctx);
         this.primitives.into_iter().for_each(|b| b.destroy(ctx));
         this.falloff.destroy(ctx);
+        this.shadow_meshes.destroy(ctx);
         this.texture.into_iter().chain(this.mask).chain(this.depth).for_each(|t| t.destroy(ctx));
     }
 }

@@ -47,7 +47,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
-use super::shadow_mesh::{SHADOW_MESH_ERROR, shadow_caster};
+use super::shadow_mesh::{SOFT_SHADOW_MESH_ERROR, shadow_caster};
 use super::smoothie_gpu::GpuSilhouettes;
 use super::{Technique, clear_visibility, surface_inputs};
 use crate::error::Result;
@@ -78,7 +78,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         DEPTH16,
         GPU_SILHOUETTES,
         MERGE,
-        SHADOW_MESH_ERROR,
+        SOFT_SHADOW_MESH_ERROR,
     ],
     create: |ctx, _, visibility| Ok(Box::new(Smoothie::new(ctx, visibility)?)),
     bench: &[
@@ -86,7 +86,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         OUTER_ONLY,
         &[("depth16", "1")],
         &[("gpu_silhouettes", "1")],
-        &[("shadow_mesh_error", "1")],
+        &[("shadow_mesh_error", "0")],
         &[("merge", "1")],
     ],
     sweep_knobs: SweepKnobs::DEFAULTS,
