@@ -2,10 +2,12 @@
 //! extraction in edges per second (one core), from the face planes built with the mesh as the
 //! plateau and smoothie do, and the CPU geometry of a frame whose caster moved, for the plateau
 //! (face planes, silhouettes, cones and sheets as one primitive each) and the smoothie (face
-//! planes, silhouettes, smoothie edges and corners). Goal: at most 2 ms a moving frame.
+//! planes, silhouettes, smoothie edges and corners), from the full mesh and from the one-texel
+//! shadow mesh both cast from by default. Goal: at most 2 ms a moving frame.
 
 use std::hint::black_box;
 use std::path::Path;
+use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
@@ -13,17 +15,22 @@ use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, ReceiverPl
 use softshadow::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
 use softshadow::geometry::smoothie::{self, SmoothieSize, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
-use softshadow::scene::Mesh;
+use softshadow::scene::{Mesh, Object, Transform};
+use softshadow::technique::shadow_mesh::texels_at_caster;
 
 fn scale(c: &mut Criterion) {
     let koala = Mesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("models/koala.obj")).unwrap();
     // As scenes/scale/koala.toml places it: standing, 1.4 m tall, over the ground.
-    let model = Mat4::from_translation(Vec3::new(0.0, 0.7, 0.0))
-        * Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)
-        * Mat4::from_scale(Vec3::splat(0.15));
+    let mut o = Object::new("koala", Arc::new(koala));
+    o.transform = Transform {
+        position: Vec3::new(0.0, 0.7, 0.0),
+        rotation_deg: Vec3::new(-90.0, 0.0, 0.0),
+        scale: Vec3::splat(0.15),
+    };
+    let model = o.transform.matrix();
     let light = Vec3::new(2.0, 7.0, 1.5);
-    let world = |m: &Mat4| -> Vec<Vec3> { koala.positions.iter().map(|p| m.transform_point3(*p)).collect() };
-    let positions = world(&model);
+    let koala = &o.mesh;
+    let positions: Vec<Vec3> = koala.positions.iter().map(|p| model.transform_point3(*p)).collect();
     let caster = Caster { positions: &positions, triangles: &koala.triangles, adjacency: &koala.adjacency };
 
     let mut group = c.benchmark_group("koala (99 994 triangles)");
@@ -44,32 +51,39 @@ fn scale(c: &mut Criterion) {
         penumbra: plateau::Penumbra::Centred,
         wedges: true,
     };
-    let mut step = 0.0f32;
-    // As the technique does: facing from the face planes, only the edges' vertices transformed.
-    group.bench_function("plateau CPU geometry, moving frame", |b| {
-        b.iter(|| {
-            step += 1e-3;
-            let model = Mat4::from_translation(Vec3::X * step) * model;
-            let source = EdgeSource::Silhouettes;
-            let edges = plateau_edges(&object, &koala.planes.light_facing(&model, light), source);
-            plateau_sides(&plane, &plateau_light, &object, &model, &edges, source, 0.0)
-        })
-    });
     let bounds = Aabb::from_points(positions.iter().copied());
     let ground = [(-6.0, -6.0), (6.0, -6.0), (6.0, 6.0), (-6.0, 6.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the koala is in view");
     let size = (SmoothieSize::Physical { light_radius: 0.3, scale: 1.0, behind: 0.0 }, frustum.far);
-    // As the technique does: silhouettes from the face planes, smoothies through view · model.
-    group.bench_function("smoothie CPU geometry, moving frame", |b| {
-        b.iter(|| {
-            step += 1e-3;
-            let model = Mat4::from_translation(Vec3::X * step) * model;
-            let edges = penumbra_edges(&object, &koala.planes.light_facing(&model, light), EdgeSource::Silhouettes);
-            let view = frustum.view * model;
-            let (near, far) = depth_range(&view, &koala.bounds);
-            smoothies(&view, &object, &edges, size, smoothie::Penumbra::Centred { near, far })
-        })
-    });
+    // The full mesh, and the one-texel shadow mesh both techniques cast from by default (built
+    // once, when the caster first casts, and cached).
+    let world = texels_at_caster(&o, light, 1.0).expect("the light is outside the koala");
+    let shadow = koala.shadow_mesh(world / 0.15);
+    for (name, mesh) in [("", koala), (", 1-texel shadow mesh", &shadow)] {
+        let object = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+        let mut step = 0.0f32;
+        // As the technique does: facing from the face planes, only the edges' vertices transformed.
+        group.bench_function(format!("plateau CPU geometry, moving frame{name}"), |b| {
+            b.iter(|| {
+                step = (step + 1e-3) % 0.05; // moving, but staying where it was placed
+                let model = Mat4::from_translation(Vec3::X * step) * model;
+                let source = EdgeSource::Silhouettes;
+                let edges = plateau_edges(&object, &mesh.planes.light_facing(&model, light), source);
+                plateau_sides(&plane, &plateau_light, &object, &model, &edges, source, 0.0)
+            })
+        });
+        // As the technique does: silhouettes from the face planes, smoothies through view · model.
+        group.bench_function(format!("smoothie CPU geometry, moving frame{name}"), |b| {
+            b.iter(|| {
+                step = (step + 1e-3) % 0.05; // moving, but staying where it was placed
+                let model = Mat4::from_translation(Vec3::X * step) * model;
+                let edges = penumbra_edges(&object, &mesh.planes.light_facing(&model, light), EdgeSource::Silhouettes);
+                let view = frustum.view * model;
+                let (near, far) = depth_range(&view, &mesh.bounds);
+                smoothies(&view, &object, &edges, size, smoothie::Penumbra::Centred { near, far })
+            })
+        });
+    }
     group.finish();
 }
 
