@@ -80,10 +80,11 @@ fn the_simplified_shadow_mesh_stays_within_its_stated_error() {
     assert!(Arc::ptr_eq(&o.mesh.shadow_mesh(0.0), &o.mesh));
 }
 
-/// Where the simplifier leaves a closed mesh with a non-manifold edge (the 100k-triangle knot at
-/// 2⁻⁹), a smaller error still gives a closed copy with far fewer triangles, not the full mesh.
+/// Where the simplifier folds a fin into a closed mesh (the 100k-triangle knot at 2⁻⁹: two
+/// triangles back to back, their edges shared by four faces), the copy drops it and stays closed
+/// with far fewer triangles, instead of the full mesh casting.
 #[test]
-fn a_simplification_that_opens_the_mesh_falls_back_to_a_finer_one() {
+fn a_simplification_that_folds_fins_still_gives_a_closed_copy() {
     let knot = Arc::new(primitives::knot(100_000).unwrap());
     let simple = knot.shadow_mesh(2f32.powi(-9));
     assert!(simple.adjacency.is_closed());

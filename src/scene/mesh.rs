@@ -131,10 +131,10 @@ impl Mesh {
     /// moving closer or farther reuses a few cached copies. This mesh itself when `error` is not
     /// positive or the simplifier removes nothing.
     ///
-    /// The simplifier can leave a closed mesh with a non-manifold edge or a hole, whose
-    /// silhouettes would stop being closed loops; then the next smaller error is tried, down to
-    /// a sixteenth (the 100k-triangle knot: one non-manifold edge at 2⁻⁹, closed at 2⁻¹⁰ with
-    /// 21k triangles), before the full mesh casts.
+    /// The simplifier can fold slivers into fins (two triangles back to back), which make their
+    /// edges non-manifold: they are dropped, so the copy stays closed and its silhouettes closed
+    /// loops. Kept, they sent the 100k-triangle knot at 2⁻⁹ and the 1M one at every error from
+    /// 2⁻⁹ to 2⁻¹⁴ (2 to 13 edges shared by four faces, each a fin) back to the full mesh.
     pub fn shadow_mesh(self: &Arc<Self>, error: f32) -> Arc<Mesh> {
         if !(error > 0.0 && error.is_finite()) {
             return self.clone();
@@ -147,24 +147,21 @@ impl Mesh {
         let indices: Vec<u32> = self.triangles.iter().flatten().copied().collect();
         let points: Vec<[f32; 3]> = self.positions.iter().map(|p| p.to_array()).collect();
         let options = meshopt::SimplifyOptions::LockBorder | meshopt::SimplifyOptions::ErrorAbsolute;
-        let mut simpler = self.clone();
-        for error in (0..5).map(|finer| 2f32.powi(exponent - finer)) {
-            let kept = meshopt::simplify_decoder(&indices, &points, 0, error, options, None);
-            let mut triangles: Vec<[u32; 3]> = kept.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
-            if triangles.len() >= self.triangles.len() {
-                break; // a smaller error removes nothing either
-            }
+        let error = 2f32.powi(exponent);
+        let kept = meshopt::simplify_decoder(&indices, &points, 0, error, options, None);
+        let mut triangles = without_fins(kept.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect());
+        let simpler = if triangles.len() < self.triangles.len() {
             let positions = used_positions(&self.positions, &mut triangles);
             let name = format!("{} (shadow, error {error})", self.name);
-            // The simplifier keeps area within a finite error; should it not, no copy.
+            // The simplifier keeps area within a finite error; should it not, or open a closed
+            // mesh otherwise than by fins (large errors can), the full mesh casts.
             match Mesh::new(name, positions, triangles) {
-                Ok(m) if m.adjacency.is_closed() || !self.adjacency.is_closed() => {
-                    simpler = Arc::new(m);
-                    break;
-                }
-                _ => {}
+                Ok(m) if m.adjacency.is_closed() || !self.adjacency.is_closed() => Arc::new(m),
+                _ => self.clone(),
             }
-        }
+        } else {
+            self.clone()
+        };
         cache.push((exponent, simpler.clone()));
         simpler
     }
@@ -295,7 +292,6 @@ fn obj_shape(text: &str) -> std::result::Result<String, String> {
     Ok(out)
 }
 
-/// Merges bit-identical positions so faces share edges (OBJ files often repeat seam vertices).
 /// The positions `triangles` use, in order of first use; `triangles` renumbered into them.
 fn used_positions(positions: &[Vec3], triangles: &mut [[u32; 3]]) -> Vec<Vec3> {
     let mut new = vec![u32::MAX; positions.len()];
@@ -310,6 +306,25 @@ fn used_positions(positions: &[Vec3], triangles: &mut [[u32; 3]]) -> Vec<Vec3> {
     used
 }
 
+/// `triangles` without the fins the simplifier can fold a sliver into: two triangles on the same
+/// corners facing opposite ways, with no inside, whose edges each had two more faces than a
+/// closed surface gives them (non-manifold). Both go; the surface around them stays closed.
+fn without_fins(triangles: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+    // A triangle's corners from its smallest, which keeps its orientation.
+    let key = |t: &[u32; 3]| {
+        let first = (0..3).min_by_key(|&k| t[k]).expect("three corners");
+        [t[first], t[(first + 1) % 3], t[(first + 2) % 3]]
+    };
+    let mut facing: HashMap<[u32; 3], usize> = HashMap::with_capacity(triangles.len());
+    for t in &triangles {
+        *facing.entry(key(t)).or_default() += 1;
+    }
+    let flipped = |t: &[u32; 3]| key(&[t[0], t[2], t[1]]);
+    let fin = |t: &[u32; 3]| facing.get(&flipped(t)).is_some_and(|&n| n == facing[&key(t)]);
+    triangles.iter().filter(|t| !fin(t)).copied().collect()
+}
+
+/// Merges bit-identical positions so faces share edges (OBJ files often repeat seam vertices).
 fn weld(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
     let mut welded = Vec::with_capacity(positions.len());
@@ -327,4 +342,20 @@ fn weld(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<[u32; 3]>
         .collect();
     let triangles = triangles.iter().map(|t| t.map(|v| remap[v as usize])).collect();
     (welded, triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fins_go_in_pairs_and_nothing_else_does() {
+        // A tetrahedron with a fin on its edge 0–1: the triangle 0 1 4 both ways round.
+        let tetrahedron = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+        let with_fin = [&tetrahedron[..], &[[0, 1, 4], [4, 1, 0]]].concat();
+        assert_eq!(without_fins(with_fin), tetrahedron);
+        // The same corners facing the same way twice is no fin.
+        let twice = vec![[0, 1, 4], [1, 4, 0]];
+        assert_eq!(without_fins(twice.clone()), twice);
+    }
 }
