@@ -108,7 +108,9 @@ float centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
 
 // Whether V at this lookup can differ from the hard test's: an alpha below 1 among the four
 // smoothie texels (an outer α' of 1 is lit, an inner α of 1 umbra), or the hard test's own
-// bilinear edge (0 < umbra < 1), which the falloff shapes.
+// bilinear edge (0 < umbra < 1), which the falloff shapes. Exact where the grids agree
+// (SAME_GRID); otherwise the mask draw keeps the map's hard test where the centred one would
+// classify the smoothie texels' centres instead.
 bool near_smoothie(vec2 uv, float umbra) {
     vec2 corner = (floor(smoothie_pos(uv)) + 1.0) / light.kernel.x;
     vec4 alpha = textureGather(smoothies, corner, 1);

@@ -6,7 +6,8 @@
 //! from the light into depth b and remapped alpha α' = α / (1 − b/r) at once, packed in one
 //! 16-bit two-channel target with minimum blending, b as a logarithmic code: see
 //! [`smoothie_format`]), `resolve` (the two depth comparisons at the four nearest texels, then
-//! the falloff).
+//! the falloff; in two draws, the second only where a smoothie is near: see
+//! [`MaskedResolve::record`]).
 //!
 //! r, the receiver's distance behind a smoothie texel, is the nearer of the casters' depth in
 //! the map (as Figure 11 reads it) and the ground plane's along the texel's ray, computed
