@@ -23,11 +23,13 @@ pub const SHADOW_MESH_ERROR: Knob = Knob {
 /// [`SHADOW_MESH_ERROR`] for the silhouette techniques' soft shadows (plateau, smoothie): on by
 /// default at one texel, which their penumbrae, many texels wide, cannot show. Fine meshes'
 /// silhouettes zigzag at the scale of their triangles, and every turn costs cones, sheets and
-/// smoothie corners (issue 18). Measured (bench, 512², lavapipe, one run each): the suite's
-/// penumbra RMSE unchanged to four places for both; hammer (60k triangles, 1 250 in its shadow
-/// mesh) plateau frame 154 → 68 ms and smoothie 151 → 51 (smoothie buffer 115 → 10), penumbra
-/// RMSE 0.077 → 0.082 and 0.069 → 0.072; koala (100k, 7 952) smoothie 176 → 128, RMSE 0.112 →
-/// 0.115. `shadow_mesh_error=0` casts from the full mesh.
+/// smoothie corners (issue 18). Measured (bench, 512², lavapipe, one run, the full mesh → this):
+/// the suite's penumbra RMSE unchanged to four places for both; on the scale scenes the plateau
+/// frame 155 → 40 ms (hammer: 60k triangles, 1 250 in its shadow mesh), 117 → 62 (knot), 160 → 75
+/// (koala: 100k, 7 952), the smoothie's 162 → 41, 131 → 83, 218 → 146 (its buffer 115 → 8, 70 →
+/// 16, 132 → 40); penumbra RMSE within 0.002 for the plateau, 0.003–0.007 higher for the
+/// smoothie (hammer 0.069 → 0.072, knot 0.061 → 0.068), whose shadow map keeps the full mesh.
+/// `shadow_mesh_error=0` casts from the full mesh.
 pub const SOFT_SHADOW_MESH_ERROR: Knob = Knob { default: 1.0, ..SHADOW_MESH_ERROR };
 
 /// Texels across the light's view of one caster that [`SHADOW_MESH_ERROR`] counts in.
