@@ -68,7 +68,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::shadow_mesh::{SOFT_SHADOW_MESH_ERROR, shadow_caster, shadow_mesh};
+use super::shadow_mesh::{SOFT_SHADOW_MESH_ERROR, shadow_caster};
 use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
@@ -230,9 +230,18 @@ pub struct Plateau {
     depth: Option<Target>,
     falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
-    sides: Vec<Option<(SidesKey, PlateauGeometry)>>,
+    sides: Vec<Option<CasterSides>>,
     /// The simplified shadow meshes the umbra pass draws (`shadow_mesh_error`).
     shadow_meshes: Uploads<MeshId, ShadowMeshBuffers>,
+}
+
+/// A caster's cached sides, and the mesh they and its umbra are cast from (the shadow mesh
+/// where `shadow_mesh_error` asks for one).
+#[derive(Clone)]
+struct CasterSides {
+    key: SidesKey,
+    geometry: PlateauGeometry,
+    mesh: Arc<Mesh>,
 }
 
 /// A shadow mesh's vertices and indices, as the frame's own meshes are drawn.
@@ -308,7 +317,7 @@ impl Plateau {
             let source = if params.is_on(&EDGES) { EdgeSource::LightFacing } else { EdgeSource::Silhouettes };
             let model = o.transform.matrix();
             let key = SidesKey { mesh: o.mesh.id(), model, light, plane: *plane, source };
-            if cached.as_ref().is_some_and(|(k, _)| *k == key) {
+            if cached.as_ref().is_some_and(|c| c.key == key) {
                 continue;
             }
             // In object space, as the smoothie: facing from the face planes built with the mesh,
@@ -319,7 +328,7 @@ impl Plateau {
             // The umbra mask's number: the draw's instance (the object's index) plus one.
             let number = (number + 1).min(u16::MAX as usize) as f32;
             let sides = plateau_sides(plane, &light, &caster, &model, &edges, source, number);
-            *cached = Some((key, sides));
+            *cached = Some(CasterSides { key, geometry: sides, mesh: o.mesh.clone() });
         }
     }
 
@@ -370,7 +379,7 @@ impl Technique for Plateau {
         };
         self.build_sides(frame, &plane, light, params);
         let mut geometry = PlateauGeometry::default();
-        self.sides.iter().flatten().for_each(|(_, g)| geometry.extend(g));
+        self.sides.iter().flatten().for_each(|c| geometry.extend(&c.geometry));
         let tex_size = params.get(&TEXTURE_SIZE) as u32;
         ensure(ctx, &mut self.texture, TargetDesc::color("plateau texture", PLATEAU_FORMAT, tex_size, tex_size))?;
         ensure(ctx, &mut self.mask, TargetDesc::color("plateau mask", MASK_FORMAT, tex_size, tex_size))?;
@@ -414,12 +423,12 @@ impl Technique for Plateau {
         // before the pass), else the frame's own.
         let mut umbra_draws = Vec::new();
         for draw in frame.draws.iter().filter(|d| d.casts) {
-            // A draw's instance is its object's index in the scene.
-            let object = frame.scene.objects.get(draw.instance as usize);
-            let mesh = object.map(|o| (shadow_mesh(o, light.position, params), &o.mesh));
-            let uploaded = match mesh {
-                Some((mesh, own)) if !Arc::ptr_eq(&mesh, own) => {
-                    Some(self.shadow_meshes.index(ctx, mesh.id(), || ShadowMeshBuffers::new(ctx, cmd, &mesh))?)
+            // A draw's instance is its object's index in the scene, as the sides are kept.
+            let i = draw.instance as usize;
+            let cast = self.sides.get(i).and_then(Option::as_ref).map(|c| &c.mesh);
+            let uploaded = match (cast, frame.scene.objects.get(i)) {
+                (Some(mesh), Some(o)) if !Arc::ptr_eq(mesh, &o.mesh) => {
+                    Some(self.shadow_meshes.index(ctx, mesh.id(), || ShadowMeshBuffers::new(ctx, cmd, mesh))?)
                 }
                 _ => None,
             };
