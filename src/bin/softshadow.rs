@@ -12,7 +12,7 @@ use softshadow::measure::{FileTrace, Metrics, TimingReport, save_difference};
 use softshadow::scene::Scene;
 use softshadow::technique::registry::{Runs, ground_truth};
 use softshadow::technique::{Kind, Params, TECHNIQUES, TechniqueInfo, find};
-use softshadow::{Capture, Engine, FrameSettings};
+use softshadow::{Capture, Engine, FrameSettings, FrameTimings};
 
 /// Frames rendered before timing starts (pipelines warm, caches filled).
 const WARMUP_FRAMES: usize = 3;
@@ -323,30 +323,43 @@ fn render_frames(
 ) -> Result<(Capture, TimingReport)> {
     let offline = settings.params.technique.kind.offline();
     let frames = frames.unwrap_or(if offline { 1 } else { 20 });
+    let (capture, measured) = timed_frames(engine, scene, settings, frames, true, trace)?;
+    let name = settings.params.technique.name;
+    let report = TimingReport::new(engine.device(), name, settings.width, settings.height, &measured);
+    Ok((capture.expect("captured"), report))
+}
+
+/// Warm-up frames (none for offline techniques), then `frames` timed ones, the last captured
+/// when `capture`; their timings.
+fn timed_frames(
+    engine: &mut Engine,
+    scene: &Scene,
+    settings: &FrameSettings,
+    frames: usize,
+    capture: bool,
+    trace: Option<(&mut FileTrace, &serde_json::Value)>,
+) -> Result<(Option<Capture>, Vec<FrameTimings>)> {
     if frames == 0 {
         bail!("--frames must be at least 1");
     }
-    let warmup = if offline { 0 } else { WARMUP_FRAMES };
+    let warmup = if settings.params.technique.kind.offline() { 0 } else { WARMUP_FRAMES };
     // Every frame rendered here is reported (or traced): keep all their timings.
     engine.set_timing_history(warmup + frames);
-    for _ in 0..warmup + frames - 1 {
+    for _ in 0..warmup + frames - usize::from(capture) {
         engine.render(scene, settings)?;
     }
-    let capture = engine.render_and_capture(scene, settings)?;
+    let captured = capture.then(|| engine.render_and_capture(scene, settings)).transpose()?;
     engine.flush()?;
-    let timings = engine.take_timings();
-    let first_measured = timings.len().saturating_sub(frames);
-    let measured = &timings[first_measured..];
+    let mut timings = engine.take_timings();
+    let measured = timings.split_off(timings.len().saturating_sub(frames));
     if let Some((trace, label)) = trace {
         let mut label = label.clone();
         label["timed"] = false.into();
-        trace.add_frames(&timings[..first_measured], &label);
+        trace.add_frames(&timings, &label);
         label["timed"] = true.into();
-        trace.add_frames(measured, &label);
+        trace.add_frames(&measured, &label);
     }
-    let name = settings.params.technique.name;
-    let report = TimingReport::new(engine.device(), name, settings.width, settings.height, measured);
-    Ok((capture, report))
+    Ok((captured, measured))
 }
 
 fn finish(engine: Engine) -> Result<()> {
@@ -538,8 +551,8 @@ fn bench(args: &BenchArgs) -> Result<()> {
         return curve(args);
     }
     use softshadow::measure::bench::{
-        BenchRow, load_reference, mark_pareto, registry_cost_goals, save_reference, setting_label, sweep, write_csv,
-        write_report,
+        BenchRow, load_reference, mark_pareto, registry_cost_goals, round_frames, save_reference, setting_label, sweep,
+        write_csv, write_report,
     };
     let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
@@ -562,6 +575,9 @@ fn bench(args: &BenchArgs) -> Result<()> {
     };
     for t in &args.techniques {
         find(t)?;
+    }
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
     }
     let runs: Vec<_> = sweep(args.quick)
         .into_iter()
@@ -604,27 +620,58 @@ fn bench(args: &BenchArgs) -> Result<()> {
             }
         };
         bar.inc(1);
-        for &(info, sets) in &runs {
-            let technique = info.name;
-            bar.set_message(format!("{name}: {technique}"));
-            let mut settings = FrameSettings { params: Params::defaults(info), ..truth_settings.clone() };
-            settings.params.apply(sets.iter().copied())?;
-            let setting = setting_label(sets);
-            let label = serde_json::json!({"scene": name, "technique": technique, "setting": setting});
-            let started = std::time::Instant::now();
-            let (capture, timings) =
-                render_frames(&mut engine, &scene, &settings, Some(args.frames), trace.as_mut().map(|t| (t, &label)))?;
-            if let Some(trace) = &mut trace {
-                let title = format!("{name}: {technique} {setting}");
-                trace.cpu_slice(title.trim_end(), started, std::time::Instant::now(), label);
+        let settings: Vec<FrameSettings> = runs
+            .iter()
+            .map(|&(info, sets)| {
+                let mut settings = FrameSettings { params: Params::defaults(info), ..truth_settings.clone() };
+                settings.params.apply(sets.iter().copied()).map(|_| settings)
+            })
+            .collect::<std::result::Result<_, _>>()?;
+        // Real-time rows in interleaved rounds (measure::bench::ROUNDS), the last captured;
+        // offline ones once, with the first.
+        let mut measured = vec![Vec::new(); runs.len()];
+        let mut captures = vec![None; runs.len()];
+        let rounds = round_frames(args.frames);
+        for (round, &frames) in rounds.iter().enumerate() {
+            let last = round + 1 == rounds.len();
+            for (i, &(info, sets)) in runs.iter().enumerate() {
+                let offline = info.kind.offline();
+                if offline && round > 0 {
+                    continue;
+                }
+                let technique = info.name;
+                bar.set_message(format!("{name}: {technique}"));
+                let setting = setting_label(sets);
+                let label = serde_json::json!({"scene": name, "technique": technique, "setting": setting});
+                let started = std::time::Instant::now();
+                let frames = if offline { 1 } else { frames };
+                let (capture, timings) = timed_frames(
+                    &mut engine,
+                    &scene,
+                    &settings[i],
+                    frames,
+                    offline || last,
+                    trace.as_mut().map(|t| (t, &label)),
+                )?;
+                if let Some(trace) = &mut trace {
+                    let title = format!("{name}: {technique} {setting}");
+                    trace.cpu_slice(title.trim_end(), started, std::time::Instant::now(), label);
+                }
+                measured[i].extend(timings);
+                if capture.is_some() {
+                    captures[i] = capture;
+                }
             }
-            let metrics = Metrics::between(&capture, &truth)?;
+        }
+        for (i, &(info, sets)) in runs.iter().enumerate() {
+            let capture = captures[i].take().expect("every row's last round captures");
+            let timings = TimingReport::new(engine.device(), info.name, size, size, &measured[i]);
             rows.push(BenchRow {
                 scene: name.clone(),
-                technique: technique.to_string(),
-                setting,
+                technique: info.name.to_string(),
+                setting: setting_label(sets),
                 timings,
-                metrics,
+                metrics: Metrics::between(&capture, &truth)?,
                 pareto: false,
             });
             bar.inc(1);

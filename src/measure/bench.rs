@@ -33,6 +33,20 @@ pub fn sweep(quick: bool) -> Vec<(&'static TechniqueInfo, Setting)> {
     if quick { first.collect() } else { first.chain(rest).collect() }
 }
 
+/// Rounds a scene's timed frames are split into, each row's share of a round rendered after the
+/// other rows' of the round before: a slow minute of a shared machine (measured here: a
+/// scene's identical prepass at 5.5–10.4 ms from one row to the next) then lands on every row
+/// of the scene alike instead of on whichever ran through it, which is what ratios between
+/// rows need.
+pub const ROUNDS: usize = 4;
+
+/// Each round's frames: `frames` split as evenly as they go into at most [`ROUNDS`] rounds of
+/// at least one frame each.
+pub fn round_frames(frames: usize) -> Vec<usize> {
+    let rounds = ROUNDS.min(frames);
+    (0..rounds).map(|r| frames / rounds + usize::from(r < frames % rounds)).collect()
+}
+
 /// `key=value` pairs separated by spaces, as [`BenchRow::setting`] holds them.
 pub fn setting_label(setting: Setting) -> String {
     setting.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
@@ -230,7 +244,8 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         let t = &r.timings;
         let _ = writeln!(
             out,
-            "{}, {}; {}x{}, GPU ms: median (p95) over {} frames after warm-up. Error against {reference}. \
+            "{}, {}; {}x{}, GPU ms: median (p95) over {} frames, timed in up to {ROUNDS} rounds interleaved \
+             across each scene's rows, each after warm-up. Error against {reference}. \
              ★ marks the Pareto-optimal rows (no other row both cheaper and more accurate in the penumbra).\n",
             t.device, t.driver, t.width, t.height, t.frames
         );
@@ -367,6 +382,16 @@ mod tests {
     }
 
     /// Both sides of every goal are settings the full sweep runs, so bench can check them.
+    #[test]
+    fn rounds_split_the_frames_evenly_and_never_empty() {
+        for frames in 1..50 {
+            let rounds = round_frames(frames);
+            assert_eq!(rounds.iter().sum::<usize>(), frames);
+            assert_eq!(rounds.len(), ROUNDS.min(frames));
+            assert!(rounds.iter().all(|&n| n >= 1 && n + 1 >= rounds[0]), "{frames}: {rounds:?}");
+        }
+    }
+
     #[test]
     fn every_cost_goal_compares_benched_settings() {
         let swept: Vec<(&str, String)> = sweep(false).iter().map(|(t, s)| (t.name, setting_label(s))).collect();
