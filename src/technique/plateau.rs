@@ -68,7 +68,7 @@ use super::falloff::{FALLOFF, Falloff, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
-use super::shadow_mesh::{SOFT_SHADOW_MESH_ERROR, shadow_caster};
+use super::shadow_mesh::{CasterMeshes, SOFT_SHADOW_MESH_ERROR, shadow_caster};
 use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
@@ -78,11 +78,10 @@ use crate::geometry::plateau::{
 };
 use crate::geometry::silhouette::{Caster, EdgeSource};
 use crate::gpu::{
-    Access, Attachment, Blend, Buffer, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
-    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Uploads, Variants, draw_generated, draw_indexed, ensure,
-    shaders, transition, upload,
+    Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
+    Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, draw_generated, ensure, shaders, transition,
 };
-use crate::scene::{Mesh, MeshId};
+use crate::scene::Mesh;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "plateau",
@@ -231,8 +230,8 @@ pub struct Plateau {
     falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
     sides: Vec<Option<CasterSides>>,
-    /// The simplified shadow meshes the umbra pass draws (`shadow_mesh_error`).
-    shadow_meshes: Uploads<MeshId, ShadowMeshBuffers>,
+    /// The meshes the umbra pass draws: the sides' (`shadow_mesh_error`).
+    casters: CasterMeshes,
 }
 
 /// A caster's cached sides, and the mesh they and its umbra are cast from (the shadow mesh
@@ -242,35 +241,6 @@ struct CasterSides {
     key: SidesKey,
     geometry: PlateauGeometry,
     mesh: Arc<Mesh>,
-}
-
-/// A shadow mesh's vertices and indices, as the frame's own meshes are drawn.
-struct ShadowMeshBuffers {
-    vertices: Buffer,
-    indices: Buffer,
-    count: u32,
-}
-
-impl ShadowMeshBuffers {
-    /// Uploads recorded into `cmd`.
-    fn new(ctx: &Context, cmd: vk::CommandBuffer, mesh: &Mesh) -> Result<Self> {
-        let (vertices, indices) = mesh.render_geometry();
-        let vertex_buffer = upload(ctx, cmd, &mesh.name, cast_slice(&vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-        match upload(ctx, cmd, &mesh.name, cast_slice(&indices), vk::BufferUsageFlags::INDEX_BUFFER) {
-            Ok(index_buffer) => {
-                Ok(ShadowMeshBuffers { vertices: vertex_buffer, indices: index_buffer, count: indices.len() as u32 })
-            }
-            Err(e) => {
-                vertex_buffer.destroy(ctx);
-                Err(e)
-            }
-        }
-    }
-
-    fn destroy(self, ctx: &Context) {
-        self.vertices.destroy(ctx);
-        self.indices.destroy(ctx);
-    }
 }
 
 impl Plateau {
@@ -299,7 +269,7 @@ impl Plateau {
             depth: None,
             falloff: Falloff::default(),
             sides: Vec::new(),
-            shadow_meshes: Uploads::new(ShadowMeshBuffers::destroy),
+            casters: CasterMeshes::default(),
         })
     }
 
@@ -421,19 +391,8 @@ impl Technique for Plateau {
         // The umbra is the casters' hard shadow: drawn from the meshes the sides came from, the
         // simplified shadow meshes where `shadow_mesh_error` asks for them (their uploads recorded
         // before the pass), else the frame's own.
-        let mut umbra_draws = Vec::new();
-        for draw in frame.draws.iter().filter(|d| d.casts) {
-            // A draw's instance is its object's index in the scene, as the sides are kept.
-            let i = draw.instance as usize;
-            let cast = self.sides.get(i).and_then(Option::as_ref).map(|c| &c.mesh);
-            let uploaded = match (cast, frame.scene.objects.get(i)) {
-                (Some(mesh), Some(o)) if !Arc::ptr_eq(mesh, &o.mesh) => {
-                    Some(self.shadow_meshes.index(ctx, mesh.id(), || ShadowMeshBuffers::new(ctx, cmd, mesh))?)
-                }
-                _ => None,
-            };
-            umbra_draws.push((draw, uploaded));
-        }
+        let sides = &self.sides;
+        self.casters.prepare(frame, |i| sides.get(i).and_then(Option::as_ref).map(|c| &c.mesh))?;
         let texture = self.texture.as_mut().expect("ensured");
         let (mask, depth) = (self.mask.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));
         // umbra: the mask cleared to 0 (no caster), then the flattened casters, the lowest nearest.
@@ -446,12 +405,7 @@ impl Technique for Plateau {
             Some(Attachment::clear_depth(depth, 1.0)),
         );
         self.umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)])?;
-        for (draw, uploaded) in umbra_draws {
-            match uploaded.map(|i| self.shadow_meshes.get(i)) {
-                Some(m) => draw_indexed(ctx, cmd, m.vertices.buffer, m.indices.buffer, m.count, draw.instance),
-                None => draw.record(ctx, cmd),
-            }
-        }
+        self.casters.record(frame);
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
@@ -516,7 +470,7 @@ impl Technique for Plateau {
         this.view.destroy(ctx);
         this.primitives.into_iter().for_each(|b| b.destroy(ctx));
         this.falloff.destroy(ctx);
-        this.shadow_meshes.destroy(ctx);
+        this.casters.destroy(ctx);
         this.texture.into_iter().chain(this.mask).chain(this.depth).for_each(|t| t.destroy(ctx));
     }
 }

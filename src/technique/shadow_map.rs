@@ -15,6 +15,7 @@ use glam::Vec4;
 
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, Kind, Receivers, SweepKnobs, TechniqueInfo};
+use super::shadow_mesh::CasterMeshes;
 use super::{Technique, clear_visibility, resolve, surface_inputs};
 use crate::error::Result;
 use crate::frame::interface::LightView;
@@ -225,16 +226,22 @@ impl ShadowMapPass {
     /// Fits the frustum to the casters that can shadow a receiver in view; `None` when there
     /// are none (nothing to render). Casters one frustum cannot hold are named in a warning.
     pub fn fit(frame: &FrameInputs<'_>) -> Option<LightFrustum> {
-        let casters = caster_bounds(frame);
+        Self::fit_to(frame, &caster_bounds(frame))
+    }
+
+    /// [`Self::fit`] to `casters`, the bounds of what each casting draw casts from, in draw
+    /// order ([`CasterMeshes::bounds`]).
+    pub fn fit_to(frame: &FrameInputs<'_>, casters: &[Aabb]) -> Option<LightFrustum> {
         let light = &frame.scene.light;
         // DESIGN.md §3: the spot looks at `light.target`, a hint the fit re-centres on the casters.
-        let fit = fit_spot_frustum(light.position, light.target, &casters, frame.receivers_in_view);
+        let fit = fit_spot_frustum(light.position, light.target, casters, frame.receivers_in_view);
         warn_clipped(frame, &fit.clipped);
         fit.frustum
     }
 
     /// Records the map; afterwards it is ready to be sampled by fragment shaders. `bias` and
     /// `filter` are passed on to the resolve in the `LightView` (glsl/common/interface.glsl).
+    /// The casters are the frame's own meshes, or `casters`' (prepared for this frame).
     pub fn record(
         &mut self,
         frame: &mut FrameInputs<'_>,
@@ -242,6 +249,7 @@ impl ShadowMapPass {
         size: u32,
         bias: [f32; 3],
         filter: Vec4,
+        casters: Option<&CasterMeshes>,
     ) -> Result<()> {
         let ctx = frame.ctx;
         ensure(ctx, &mut self.map, TargetDesc::color("shadow map", self.format, size, size))?;
@@ -271,7 +279,10 @@ impl ShadowMapPass {
             cmd,
             &[Descriptor::Buffer(self.light.range(frame.slot)), Descriptor::Buffer(frame.objects)],
         )?;
-        draw_casters(frame);
+        match casters {
+            Some(casters) => casters.record(frame),
+            None => draw_casters(frame),
+        }
         pass.end(ctx, cmd);
         transition(ctx, cmd, &mut [(map, Access::FRAGMENT_READ, false)]);
         frame.timer.end(ctx, cmd);
@@ -348,7 +359,7 @@ impl Technique for ShadowMap {
         let size = params.get(&SHADOW_MAP_SIZE) as u32;
         let bias = texel_biases(params);
         let (filter, filter_params) = self.filter(params, frame, &frustum);
-        self.pass.record(frame, &frustum, size, bias, filter_params)?;
+        self.pass.record(frame, &frustum, size, bias, filter_params, None)?;
 
         let world = self.technique.name == PCF.name && params.is_on(&RADIUS_WORLD);
         let format = self.visibility;

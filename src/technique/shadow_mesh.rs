@@ -1,14 +1,22 @@
 //! The optional simplified shadow mesh per caster, the DDJ's "separate shadowing and drawing
 //! models": the silhouette techniques find silhouettes on a simpler copy of each caster
-//! ([`Mesh::shadow_mesh`]) while the camera still draws the full one. The error bound is in
-//! texels of the light's view, so a technique sets it where a texel is what it can show.
+//! ([`Mesh::shadow_mesh`]) while the camera still draws the full one, and draw their hard
+//! shadows from it too ([`CasterMeshes`]: the plateau's umbra, the smoothie's map), so that hard
+//! edge and penumbra come from one outline. The error bound is in texels of the light's view,
+//! so a technique sets it where a texel is what it can show.
 
 use std::sync::Arc;
 
+use ash::vk;
+use bytemuck::cast_slice;
 use glam::Vec3;
 
 use super::knobs::{Knob, Params};
-use crate::scene::{Mesh, Object};
+use crate::error::Result;
+use crate::frame::FrameInputs;
+use crate::geometry::Aabb;
+use crate::gpu::{Buffer, Context, Uploads, draw_indexed, upload};
+use crate::scene::{Mesh, MeshId, Object};
 
 /// Declared by each technique that casts from [`shadow_caster`].
 pub const SHADOW_MESH_ERROR: Knob = Knob {
@@ -63,4 +71,104 @@ pub fn shadow_mesh(o: &Object, light: Vec3, params: &Params) -> Arc<Mesh> {
 /// `o` as its shadow is cast: a copy whose mesh is [`shadow_mesh`]'s.
 pub fn shadow_caster(o: &Object, light: Vec3, params: &Params) -> Object {
     Object { mesh: shadow_mesh(o, light, params), ..o.clone() }
+}
+
+/// A shadow mesh's vertices and indices, as the frame's own meshes are drawn.
+struct MeshBuffers {
+    vertices: Buffer,
+    indices: Buffer,
+    count: u32,
+}
+
+impl MeshBuffers {
+    /// Uploads recorded into `cmd`.
+    fn new(ctx: &Context, cmd: vk::CommandBuffer, mesh: &Mesh) -> Result<Self> {
+        let (vertices, indices) = mesh.render_geometry();
+        let vertex_buffer = upload(ctx, cmd, &mesh.name, cast_slice(&vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        match upload(ctx, cmd, &mesh.name, cast_slice(&indices), vk::BufferUsageFlags::INDEX_BUFFER) {
+            Ok(index_buffer) => {
+                Ok(MeshBuffers { vertices: vertex_buffer, indices: index_buffer, count: indices.len() as u32 })
+            }
+            Err(e) => {
+                vertex_buffer.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy(self, ctx: &Context) {
+        self.vertices.destroy(ctx);
+        self.indices.destroy(ctx);
+    }
+}
+
+/// The frame's casters as a pass that casts their shadows draws them: each from the mesh its
+/// shadow is cast from, the simplified one uploaded once (per mesh, while it lives) where it is
+/// not the object's own.
+pub struct CasterMeshes {
+    uploads: Uploads<MeshId, MeshBuffers>,
+    /// Per casting draw of this frame, in draw order: the upload it draws (`None`: its own
+    /// mesh), and the world bounds of what it draws.
+    chosen: Vec<(Option<usize>, Aabb)>,
+}
+
+impl Default for CasterMeshes {
+    fn default() -> Self {
+        CasterMeshes { uploads: Uploads::new(MeshBuffers::destroy), chosen: Vec::new() }
+    }
+}
+
+impl CasterMeshes {
+    /// Chooses this frame's meshes, `cast(i)` being the mesh scene object `i` casts from (`None`:
+    /// its own), and records the uploads of new ones into the frame's command buffer: call it
+    /// outside a render pass.
+    pub fn prepare<'m>(
+        &mut self,
+        frame: &FrameInputs<'_>,
+        cast: impl Fn(usize) -> Option<&'m Arc<Mesh>>,
+    ) -> Result<()> {
+        self.chosen.clear();
+        for draw in frame.draws.iter().filter(|d| d.casts) {
+            // A draw's instance is its object's index in the scene.
+            let i = draw.instance as usize;
+            let chosen = match (cast(i), frame.scene.objects.get(i)) {
+                (Some(mesh), Some(o)) if !Arc::ptr_eq(mesh, &o.mesh) => {
+                    let upload =
+                        self.uploads.index(frame.ctx, mesh.id(), || MeshBuffers::new(frame.ctx, frame.cmd, mesh))?;
+                    (Some(upload), mesh.bounds.transformed(&o.transform.matrix()))
+                }
+                _ => (None, draw.bounds),
+            };
+            self.chosen.push(chosen);
+        }
+        Ok(())
+    }
+
+    /// Records every caster as [`Self::prepare`] chose (inside a pass whose pipeline, of vertex
+    /// input [`MESH_POSITIONS`](crate::frame::MESH_POSITIONS), is bound).
+    pub fn record(&self, frame: &FrameInputs<'_>) {
+        for (draw, (upload, _)) in frame.draws.iter().filter(|d| d.casts).zip(&self.chosen) {
+            match upload.map(|u| self.uploads.get(u)) {
+                Some(m) => {
+                    draw_indexed(frame.ctx, frame.cmd, m.vertices.buffer, m.indices.buffer, m.count, draw.instance)
+                }
+                None => draw.record(frame.ctx, frame.cmd),
+            }
+        }
+    }
+
+    /// Whether any caster draws a simplified copy this frame.
+    pub fn simplified(&self) -> bool {
+        self.chosen.iter().any(|(upload, _)| upload.is_some())
+    }
+
+    /// The world bounds of what each casting draw draws, in draw order, as
+    /// [`caster_bounds`](super::shadow_map::caster_bounds) gives the frame's own.
+    pub fn bounds(&self) -> Vec<Aabb> {
+        self.chosen.iter().map(|(_, bounds)| *bounds).collect()
+    }
+
+    pub fn destroy(self, ctx: &Context) {
+        self.uploads.destroy(ctx);
+    }
 }
