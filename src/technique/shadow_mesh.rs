@@ -25,7 +25,7 @@ pub const SHADOW_MESH_ERROR: Knob = Knob {
     min: 0.0,
     max: 64.0,
     integer: false,
-    help: "silhouettes from a simplified caster straying at most this many texels of a 1024² light view fitted to it; 0: the full mesh",
+    help: "shadows cast from a simplified caster straying at most this many texels of a 1024² light view fitted to it; 0: the full mesh",
 };
 
 /// [`SHADOW_MESH_ERROR`] for the silhouette techniques' soft shadows (plateau, smoothie): on by
@@ -34,10 +34,12 @@ pub const SHADOW_MESH_ERROR: Knob = Knob {
 /// smoothie corners (issue 18). Measured (bench, 512², lavapipe, one run, the full mesh → this):
 /// the suite's penumbra RMSE unchanged to four places for both; on the scale scenes the plateau
 /// frame 155 → 40 ms (hammer: 60k triangles, 1 250 in its shadow mesh), 117 → 62 (knot), 160 → 75
-/// (koala: 100k, 7 952), the smoothie's 162 → 41, 131 → 83, 218 → 146 (its buffer 115 → 8, 70 →
-/// 16, 132 → 40); penumbra RMSE within 0.002 for the plateau, 0.003–0.007 higher for the
-/// smoothie (hammer 0.069 → 0.072, knot 0.061 → 0.068), whose shadow map keeps the full mesh.
-/// `shadow_mesh_error=0` casts from the full mesh.
+/// (koala: 100k, 7 952), penumbra RMSE within 0.002. The smoothie's map is cast from the copy
+/// too (a later run, 20 frames): its frame 195 → 53 ms (hammer), 134 → 64 (knot), 219 → 91
+/// (koala), its buffer 148 → 14, 71 → 19, 129 → 37 and its map 34 → 4.5 on the koala; penumbra
+/// RMSE 0.001–0.003 *lower* than the full mesh's (hammer 0.069 → 0.066, knot 0.061 → 0.058),
+/// the hard edge now being where its silhouettes are. `shadow_mesh_error=0` casts from the
+/// full mesh.
 pub const SOFT_SHADOW_MESH_ERROR: Knob = Knob { default: 1.0, ..SHADOW_MESH_ERROR };
 
 /// Texels across the light's view of one caster that [`SHADOW_MESH_ERROR`] counts in.
