@@ -452,7 +452,7 @@ impl Technique for Smoothie {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }
             let gpu = self.gpu.as_mut().expect("made above");
-            let (vertices, args) = gpu.record(frame, params, &frustum.view, (smoothie_size, frustum.far), centred)?;
+            let (vertices, args) = gpu.record(frame, &cast, &frustum.view, (smoothie_size, frustum.far), centred)?;
             Smoothies::Indirect { vertices, args }
         } else {
             // The merge bound in tangent units: texels of the smoothie buffer over the window.

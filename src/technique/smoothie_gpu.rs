@@ -7,12 +7,12 @@
 //! (one copy, not one per frame in flight) is only recomputed when a caster, the light view or
 //! the smoothie size changed: a static scene records no silhouette work after its first frame.
 
+use std::sync::Arc;
+
 use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec4};
 
-use super::knobs::Params;
-use super::shadow_mesh::shadow_caster;
 use super::smoothie::penumbra;
 use crate::error::Result;
 use crate::frame::FrameInputs;
@@ -22,7 +22,7 @@ use crate::gpu::{
     Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
     buffer_barrier, dispatch, shaders, update_buffer, upload,
 };
-use crate::scene::{Mesh, MeshId};
+use crate::scene::{Mesh, MeshId, Object};
 
 const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
@@ -115,22 +115,21 @@ impl GpuSilhouettes {
         })
     }
 
-    /// Records the silhouette dispatches of every caster (its shadow mesh, by `knobs`) seen
-    /// through `view`; returns the vertex buffer and the indirect draw arguments the smoothie
-    /// pass draws from.
+    /// Records the silhouette dispatches of every caster seen through `view`, each from the mesh
+    /// `cast` gives its scene object (the shadow mesh the map is drawn from, as on the CPU path);
+    /// returns the vertex buffer and the indirect draw arguments the smoothie pass draws from.
     pub fn record(
         &mut self,
         frame: &mut FrameInputs<'_>,
-        knobs: &Params,
+        cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
         (size, far): (SmoothieSize, f32),
         centred: bool,
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
-        // The simplified shadow meshes where `shadow_mesh_error` asks for them, as the CPU path.
-        let light = frame.scene.light.position;
-        let casters: Vec<_> =
-            frame.scene.objects.iter().filter(|o| o.casts).map(|o| shadow_caster(o, light, knobs)).collect();
+        let casters: Vec<Object> = (frame.scene.objects.iter().zip(cast))
+            .filter_map(|(o, mesh)| Some(Object { mesh: mesh.clone()?, ..o.clone() }))
+            .collect();
         let cmd = frame.cmd;
         let meshes = casters
             .iter()
