@@ -190,8 +190,7 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
             // The rays from p towards the light sphere form a cone of half-angle α about the
             // axis from the light through p, tilted θ from the plane's normal. Across the tilt
             // its section spans h·tan(θ ± α) from p's foot, so its middle lies beyond the
-            // projected vertex (at h·tan θ); sideways about h·tan α / cos θ (§3's ellipse,
-            // major axis away from the light).
+            // projected vertex (at h·tan θ) (§3's ellipse, major axis away from the light).
             let axis = (p - plane.origin - (light - plane.origin)).normalize();
             let away = Vec2::new(axis.dot(plane.u), axis.dot(plane.v));
             let (sin_theta, major) = (away.length().min(1.0), away.try_normalize().unwrap_or(Vec2::X));
@@ -199,11 +198,20 @@ pub fn vertex_cone(plane: &ReceiverPlane, light: Vec3, radius: f32, size: Penumb
             // Past the cap the section keeps the shape it has there: tilt held so that its far
             // side sits at the cap.
             let cap = MAX_TILT_TAN.atan();
-            let theta = sin_theta.asin().min((cap - alpha).max(0.0));
+            let true_theta = sin_theta.asin();
+            let theta = true_theta.min((cap - alpha).max(0.0));
             let tan = |x: f32| x.min(cap).tan();
             let semi_major = 0.5 * h * (tan(theta + alpha) - tan(theta - alpha));
-            let semi_minor = h * tan(alpha) / theta.cos();
             let beyond = 0.5 * h * (tan(theta + alpha) + tan(theta - alpha)) - h * theta.tan();
+            // Sideways, the base passes through the section's exact half width at the projected
+            // vertex, h·tan α / cos θ: the slope of the penumbra along an edge running away from
+            // the light (tan α / sin θ per unit of shadow) needs no cap. The section's own minor
+            // axis, h·sin α / √(cos(θ + α)·cos(θ − α)), is what this gives below the cap; taking
+            // h·tan α / cos θ as the minor axis instead, as the width at the ellipse's middle, made
+            // a 12° light's long edges 17 % too narrow.
+            let through = h * alpha.tan() / true_theta.cos().max(f32::EPSILON);
+            let off_middle = if semi_major > 0.0 { (beyond / semi_major).min(1.0) } else { 0.0 };
+            let semi_minor = through / (1.0 - off_middle * off_middle).max(f32::EPSILON).sqrt();
             let minor = major.perp();
             Some(Cone {
                 centre,
@@ -1212,7 +1220,7 @@ mod tests {
             let cone = vertex_cone(&plane, light, 0.5, size, p).unwrap();
             let (major, minor) = (cone.axes.col(0), cone.axes.col(1));
             assert!(major.is_finite() && minor.is_finite() && cone.centre.is_finite());
-            assert!(major.length() >= minor.length() && major.length() > first, "{elevation}°");
+            assert!(major.length() > first, "{elevation}°");
             assert!(major.length() <= MAX_TILT_TAN * p.y, "{elevation}°: capped");
             assert!(major.x.abs() > 0.99 * major.length(), "the major axis points along the light's azimuth");
             // The footprint reaches further beyond the projected vertex than short of it.
@@ -1228,6 +1236,41 @@ mod tests {
         // Haines' constant factor: radius = factor × height.
         let haines = vertex_cone(&plane, Vec3::Y * 5.0, 0.5, PenumbraSize::Haines { factor: 0.1 }, p).unwrap();
         assert!((haines.axes.col(0).length() - 0.1).abs() < 1e-6);
+    }
+
+    /// Where the ray from `p` along `d` meets the ground, in its (u, v).
+    fn ground_hit(p: Vec3, d: Vec3) -> Vec2 {
+        let hit = p + d * (-p.y / d.y);
+        Vec2::new(hit.x, hit.z)
+    }
+
+    #[test]
+    fn a_cone_base_is_the_section_of_the_rays_to_the_light_sphere() {
+        let plane = ReceiverPlane::ground(0.0);
+        let p = Vec3::new(0.3, 1.2, -0.2);
+        for elevation in [80.0f32, 45.0, 20.0, 12.0, 6.0, 3.0] {
+            let e = elevation.to_radians();
+            let light = p + Vec3::new(8.0 * e.cos(), 8.0 * e.sin(), 1.5 * e.cos());
+            let cone = vertex_cone(&plane, light, 0.4, PenumbraSize::Physical { scale: 1.0 }, p).unwrap();
+            let on_rim = |x: Vec2| (cone.axes.inverse() * (x - cone.centre - cone.offset)).length();
+            // The cone of rays from p that graze the sphere, about the axis from the light.
+            let axis = (p - light).normalize();
+            let alpha = (0.4 / (p - light).length()).asin();
+            let side = axis.cross(Vec3::Y).normalize();
+            let up = side.cross(axis);
+            let below_cap = (axis.y.abs().acos() + alpha).tan() < MAX_TILT_TAN;
+            for k in 0..16 {
+                let phi = k as f32 * TAU / 16.0;
+                let ray = axis * alpha.cos() + (side * phi.cos() + up * phi.sin()) * alpha.sin();
+                let sideways = k % 8 == 0;
+                // Below the cap, the whole section; past it, the sideways rays still, which
+                // set the penumbra's width along an edge that runs away from the light.
+                if below_cap || sideways {
+                    let r = on_rim(ground_hit(p, ray));
+                    assert!((r - 1.0).abs() < 2e-3, "{elevation}°, ray {k}: at {r} of the rim");
+                }
+            }
+        }
     }
 
     #[test]

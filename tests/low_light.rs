@@ -1,0 +1,58 @@
+//! Low lights on lavapipe, against the GPU reference: the long edge a vertical edge casts away
+//! from a light near the horizon (Haines §3's stretched footprints) has the true penumbra, on both
+//! sides of its hard edge, for both silhouette techniques.
+
+mod common;
+
+use common::{engine, finish, reference, render_with, top_down};
+use softshadow::Capture;
+
+/// Half the ground seen, in metres: the camera looks straight down at (−4, 0, 0).
+const HALF: f32 = 0.4;
+
+/// V down the middle column, with each pixel's world z (rows run along +z).
+fn column(c: &Capture) -> Vec<(f32, f32)> {
+    let to_z = |px: u32| -HALF + (px as f32 + 0.5) / c.height as f32 * 2.0 * HALF;
+    (0..c.height).map(|px| (to_z(px), c.visibility_at(c.width / 2, px))).collect()
+}
+
+/// Where the profile first rises through V = `level`, interpolated.
+fn crossing(profile: &[(f32, f32)], level: f32) -> f32 {
+    let w = profile.windows(2).find(|w| w[0].1 < level && w[1].1 >= level).expect("a penumbra across the column");
+    w[0].0 + (level - w[0].1) / (w[1].1 - w[0].1) * (w[1].0 - w[0].0)
+}
+
+/// A wall 0.1 m thick along the light's direction, 1.2 m tall and 2 m across, under a light of
+/// radius 0.4 m 8 m away and 2.2 m up (about 10° above the horizon from where the column's
+/// penumbra comes from, 7° from the wall's top). Its end at z = −0.51 casts an edge that runs
+/// away from the light and crosses the column at x = −4, z = 0, 4.1 m behind the edge: half
+/// width R·4.1/8.0 = 0.2 m on each side. The end face and the wall's far side face away from
+/// the light, so one silhouette edge casts the whole penumbra (no face seen edge-on).
+#[test]
+fn a_low_light_s_long_edge_has_the_true_penumbra_on_both_sides() {
+    let wall = "[[object]]\nshape = \"box\"\nsize = [0.1, 1.2, 2.0]\nposition = [0.0, 0.6, -1.509]\n";
+    let s = top_down(-4.0, HALF, [8.0, 2.2, -1.509], 0.4, wall);
+    let mut e = engine();
+    let truth = column(&reference(&mut e, &s, 128));
+    let widths = |p: &[(f32, f32)]| {
+        let (start, middle, end) = (crossing(p, 0.05), crossing(p, 0.5), crossing(p, 0.95));
+        (middle, middle - start, end - middle)
+    };
+    let (true_edge, true_inner, true_outer) = widths(&truth);
+    assert!(true_inner > 0.1 && true_outer > 0.1, "the reference's penumbra: {true_inner} + {true_outer} m");
+    for technique in ["plateau", "smoothie"] {
+        let (edge, inner, outer) = widths(&column(&render_with(&mut e, &s, technique, &[], 128)));
+        eprintln!(
+            "{technique}: V = ½ at z {edge:.3} (truth {true_edge:.3}), inner {inner:.3} m (truth {true_inner:.3}), \
+             outer {outer:.3} m (truth {true_outer:.3})"
+        );
+        assert!(
+            (edge - true_edge).abs() <= 0.1 * true_inner,
+            "{technique}: V = ½ at {edge}, the truth's at {true_edge}"
+        );
+        for (got, want, side) in [(inner, true_inner, "inner"), (outer, true_outer, "outer")] {
+            assert!((got / want - 1.0).abs() <= 0.1, "{technique}: {side} width {got} m, the reference's {want} m");
+        }
+    }
+    finish(e);
+}
