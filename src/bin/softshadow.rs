@@ -551,8 +551,8 @@ fn bench(args: &BenchArgs) -> Result<()> {
         return curve(args);
     }
     use softshadow::measure::bench::{
-        BenchRow, load_reference, mark_pareto, registry_cost_goals, round_frames, save_reference, setting_label, sweep,
-        write_csv, write_report,
+        BenchRow, leak_goals, load_reference, mark_pareto, registry_cost_goals, round_frames, save_reference,
+        setting_label, sweep, write_csv, write_report,
     };
     let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
@@ -684,7 +684,11 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
-    registry_cost_goals().iter().filter_map(|g| g.outcome(&rows)).for_each(|line| println!("{line}"));
+    registry_cost_goals()
+        .iter()
+        .chain(&leak_goals())
+        .filter_map(|g| g.outcome(&rows))
+        .for_each(|line| println!("{line}"));
     if let (Some(trace), Some(p)) = (trace, &args.trace) {
         trace.finish()?;
         println!("wrote {}", p.display());

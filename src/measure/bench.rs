@@ -52,19 +52,28 @@ pub fn setting_label(setting: Setting) -> String {
     setting.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
 }
 
-/// A cost goal from a technique's registry entry, as bench rows name it: `technique
-/// [setting]`'s frame costs at most `max_ratio` times the `baseline [baseline_setting]` frame,
+/// What a goal compares between a row and its baseline row, scene by scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Measure {
+    /// Median GPU ms: the row's at most `max_ratio` times the baseline's.
+    Cost { max_ratio: f64 },
+    /// Light-leak rate: the row's no higher than the baseline's (issue 20: a centred penumbra
+    /// may not leak where the papers' outer-only form does not).
+    Leaks,
+}
+
+/// A goal as bench rows name it: `technique [setting]` against `baseline [baseline_setting]`,
 /// compared per scene within one run.
 #[derive(Clone, Debug)]
-pub struct CostGoal {
+pub struct Goal {
     pub technique: &'static str,
     pub setting: String,
     pub baseline: &'static str,
     pub baseline_setting: String,
-    pub max_ratio: f64,
+    pub measure: Measure,
 }
 
-/// Goals between settings beyond each entry's own `cost_goal`: (technique, goal).
+/// Cost goals between settings beyond each entry's own `cost_goal`: (technique, goal).
 pub const COST_GOALS: &[(&TechniqueInfo, registry::CostGoal)] = &[
     // Issue 20: the centred forms (the defaults) cost little more than the papers' outer-only
     // forms, well under PCSS (16 + 16), and a smoothie of either form about what a hard map of
@@ -77,6 +86,11 @@ pub const COST_GOALS: &[(&TechniqueInfo, registry::CostGoal)] = &[
     (&smoothie::INFO, goal(smoothie::OUTER_ONLY, &shadow_map::INFO, &[("shadow_map_size", "1024")], 1.15)),
 ];
 
+/// Issue 20's leak rule: each centred default leaks no more than its outer-only form, on every
+/// scene. (technique, the outer-only setting.)
+pub const LEAK_GOALS: &[(&TechniqueInfo, Setting)] =
+    &[(&plateau::INFO, plateau::OUTER_ONLY), (&smoothie::INFO, smoothie::OUTER_ONLY)];
+
 const fn goal(
     setting: Setting,
     baseline: &'static TechniqueInfo,
@@ -87,86 +101,131 @@ const fn goal(
 }
 
 /// Every technique's cost goal, in registry order, then [`COST_GOALS`].
-pub fn registry_cost_goals() -> Vec<CostGoal> {
+pub fn registry_cost_goals() -> Vec<Goal> {
     let entries = TECHNIQUES.iter().filter_map(|t| t.cost_goal.map(|g| (*t, g)));
     entries
         .chain(COST_GOALS.iter().copied())
-        .map(|(t, g)| CostGoal {
+        .map(|(t, g)| Goal {
             technique: t.name,
             setting: setting_label(g.setting),
             baseline: g.baseline.name,
             baseline_setting: setting_label(g.baseline_setting),
-            max_ratio: g.max_ratio,
+            measure: Measure::Cost { max_ratio: g.max_ratio },
         })
         .collect()
 }
 
-impl CostGoal {
-    /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`.
+/// [`LEAK_GOALS`] as goals.
+pub fn leak_goals() -> Vec<Goal> {
+    LEAK_GOALS
+        .iter()
+        .map(|&(t, outer)| Goal {
+            technique: t.name,
+            setting: String::new(),
+            baseline: t.name,
+            baseline_setting: setting_label(outer),
+            measure: Measure::Leaks,
+        })
+        .collect()
+}
+
+/// A scene's (name, row's value, baseline's value) under one goal.
+pub type SceneValues<'a> = (&'a str, f64, f64);
+
+impl Goal {
+    /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`
+    /// or `plateau leaks ≤ plateau penumbra=0 falloff=0`.
     pub fn label(&self) -> String {
         let side = |t: &str, s: &str| if s.is_empty() { t.to_string() } else { format!("{t} {s}") };
-        format!(
-            "{} / {} ≤ {}",
-            side(self.technique, &self.setting),
-            side(self.baseline, &self.baseline_setting),
-            self.max_ratio
-        )
+        let (of, base) = (side(self.technique, &self.setting), side(self.baseline, &self.baseline_setting));
+        match self.measure {
+            Measure::Cost { max_ratio } => format!("{of} / {base} ≤ {max_ratio}"),
+            Measure::Leaks => format!("{of} leaks ≤ {base}"),
+        }
     }
 
-    /// Per scene holding both rows, the ratio of their median GPU ms, in the rows' scene order.
-    pub fn ratios<'a>(&self, rows: &'a [BenchRow]) -> Vec<(&'a str, f64)> {
-        let ms = |scene: &str, technique: &str, setting: &str| {
-            rows.iter()
-                .find(|r| r.scene == scene && r.technique == technique && r.setting == setting)
-                .map(|r| r.timings.gpu_ms_total_median)
+    /// What the goal compares in a row.
+    fn value(&self, row: &BenchRow) -> f64 {
+        match self.measure {
+            Measure::Cost { .. } => row.timings.gpu_ms_total_median,
+            Measure::Leaks => row.metrics.leak_rate,
+        }
+    }
+
+    /// Per scene holding both rows, (the row's value, the baseline's), in the rows' scene order.
+    pub fn values<'a>(&self, rows: &'a [BenchRow]) -> Vec<SceneValues<'a>> {
+        let find = |scene: &str, technique: &str, setting: &str| {
+            rows.iter().find(|r| r.scene == scene && r.technique == technique && r.setting == setting)
         };
         scenes(rows)
             .into_iter()
             .filter_map(|scene| {
-                let of = ms(scene, self.technique, &self.setting)?;
-                let base = ms(scene, self.baseline, &self.baseline_setting)?;
-                Some((scene, of / base))
+                let of = find(scene, self.technique, &self.setting)?;
+                let base = find(scene, self.baseline, &self.baseline_setting)?;
+                Some((scene, self.value(of), self.value(base)))
             })
             .collect()
+    }
+
+    pub fn met(&self, of: f64, base: f64) -> bool {
+        match self.measure {
+            Measure::Cost { max_ratio } => of <= max_ratio * base,
+            Measure::Leaks => of <= base,
+        }
+    }
+
+    /// A table cell: the ratio of a cost, both rates of a leak rule.
+    fn cell(&self, of: f64, base: f64) -> String {
+        let mark = if self.met(of, base) { "✓" } else { "✗" };
+        match self.measure {
+            Measure::Cost { .. } => format!("{:.2} {mark}", of / base),
+            Measure::Leaks => format!("{of:.5} vs {base:.5} {mark}"),
+        }
     }
 
     /// One line for the terminal, e.g. `smoothie / shadow-map … ≤ 1.3: met on 9/10 scenes
     /// (0.95–1.35)`; `None` when no scene has both rows.
     pub fn outcome(&self, rows: &[BenchRow]) -> Option<String> {
-        let ratios: Vec<f64> = self.ratios(rows).into_iter().map(|(_, r)| r).collect();
-        let lo = ratios.iter().copied().reduce(f64::min)?;
-        let hi = ratios.iter().copied().reduce(f64::max)?;
-        let met = ratios.iter().filter(|r| **r <= self.max_ratio).count();
-        Some(format!("{}: met on {met}/{} scenes ({lo:.2}–{hi:.2})", self.label(), ratios.len()))
+        let values = self.values(rows);
+        let met = values.iter().filter(|(_, of, base)| self.met(*of, *base)).count();
+        let range = match self.measure {
+            Measure::Cost { .. } => {
+                let ratios = values.iter().map(|(_, of, base)| of / base);
+                let lo = ratios.clone().reduce(f64::min)?;
+                format!(" ({lo:.2}–{:.2})", ratios.reduce(f64::max)?)
+            }
+            Measure::Leaks if values.is_empty() => return None,
+            Measure::Leaks => String::new(),
+        };
+        Some(format!("{}: met on {met}/{} scenes{range}", self.label(), values.len()))
     }
 }
 
-/// The cost goals as a table, scene by scene, with how many scenes meet each; empty when no
-/// goal has both of its rows in `rows`.
-pub fn cost_goal_table(goals: Vec<CostGoal>, rows: &[BenchRow]) -> String {
-    let goals: Vec<(CostGoal, Vec<(&str, f64)>)> = goals
+/// Goals as a table under `heading`, scene by scene, with how many scenes meet each; empty when
+/// no goal has both of its rows in `rows`.
+pub fn goal_table(heading: &str, goals: Vec<Goal>, rows: &[BenchRow]) -> String {
+    let goals: Vec<(Goal, Vec<SceneValues<'_>>)> = goals
         .into_iter()
         .map(|g| {
-            let r = g.ratios(rows);
-            (g, r)
+            let v = g.values(rows);
+            (g, v)
         })
-        .filter(|(_, r)| !r.is_empty())
+        .filter(|(_, v)| !v.is_empty())
         .collect();
     if goals.is_empty() {
         return String::new();
     }
-    let mut out =
-        String::from("## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds.\n\n| scene |");
+    let mut out = format!("{heading}\n\n| scene |");
     for (g, _) in &goals {
         let _ = write!(out, " {} |", g.label());
     }
     let _ = write!(out, "\n|---|{}\n", "---|".repeat(goals.len()));
     for scene in scenes(rows) {
         let _ = write!(out, "| {scene} |");
-        for (g, ratios) in &goals {
-            match ratios.iter().find(|(s, _)| *s == scene) {
-                Some((_, r)) => {
-                    let _ = write!(out, " {r:.2} {} |", if *r <= g.max_ratio { "✓" } else { "✗" });
+        for (g, values) in &goals {
+            match values.iter().find(|(s, ..)| *s == scene) {
+                Some(&(_, of, base)) => {
+                    let _ = write!(out, " {} |", g.cell(of, base));
                 }
                 None => out += " |",
             }
@@ -174,11 +233,17 @@ pub fn cost_goal_table(goals: Vec<CostGoal>, rows: &[BenchRow]) -> String {
         out += "\n";
     }
     out += "| met |";
-    for (g, ratios) in &goals {
-        let _ = write!(out, " {}/{} |", ratios.iter().filter(|(_, r)| *r <= g.max_ratio).count(), ratios.len());
+    for (g, values) in &goals {
+        let met = values.iter().filter(|(_, of, base)| g.met(*of, *base)).count();
+        let _ = write!(out, " {met}/{} |", values.len());
     }
     out + "\n\n"
 }
+
+/// Headings of the report's goal tables.
+pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds.";
+pub const LEAK_HEADING: &str = "## Leak rule\n\nLight-leak rates (V above the reference by more than 0.1), the centred \
+     default against the papers' outer-only form; ✓ where it leaks no more.";
 
 /// The scenes of `rows`, in their order (the sweep keeps each scene's rows together).
 fn scenes(rows: &[BenchRow]) -> Vec<&str> {
@@ -251,7 +316,8 @@ pub fn write_report(rows: &[BenchRow], reference: &str, path: &Path) -> Result<(
         );
     }
     out += &summary(rows);
-    out += &cost_goal_table(registry_cost_goals(), rows);
+    out += &goal_table(COST_HEADING, registry_cost_goals(), rows);
+    out += &goal_table(LEAK_HEADING, leak_goals(), rows);
     for scene in scenes(rows) {
         let mut of_scene: Vec<&BenchRow> = rows.iter().filter(|r| r.scene == scene).collect();
         of_scene.sort_by(|a, b| a.timings.gpu_ms_total_median.total_cmp(&b.timings.gpu_ms_total_median));
@@ -381,7 +447,6 @@ mod tests {
         }
     }
 
-    /// Both sides of every goal are settings the full sweep runs, so bench can check them.
     #[test]
     fn rounds_split_the_frames_evenly_and_never_empty() {
         for frames in 1..50 {
@@ -392,10 +457,11 @@ mod tests {
         }
     }
 
+    /// Both sides of every goal are settings the full sweep runs, so bench can check them.
     #[test]
-    fn every_cost_goal_compares_benched_settings() {
+    fn every_goal_compares_benched_settings() {
         let swept: Vec<(&str, String)> = sweep(false).iter().map(|(t, s)| (t.name, setting_label(s))).collect();
-        for g in registry_cost_goals() {
+        for g in registry_cost_goals().into_iter().chain(leak_goals()) {
             for side in [(g.technique, &g.setting), (g.baseline, &g.baseline_setting)] {
                 assert!(
                     swept.iter().any(|(t, s)| *t == side.0 && s == side.1),
@@ -417,24 +483,49 @@ mod tests {
             row("b", "soft", "", 6.0),
             row("c", "soft", "", 1.0),
         ];
-        let goal = |technique| CostGoal {
+        let goal = |technique| Goal {
             technique,
             setting: String::new(),
             baseline: "base",
             baseline_setting: "size=1024".into(),
-            max_ratio: 1.3,
+            measure: Measure::Cost { max_ratio: 1.3 },
         };
         let soft = goal("soft");
         // Scene c has no baseline row, so it has no ratio rather than a made-up one.
-        assert_eq!(soft.ratios(&rows), vec![("a", 1.2), ("b", 1.5)]);
+        assert_eq!(soft.values(&rows), vec![("a", 6.0, 5.0), ("b", 6.0, 4.0)]);
         assert_eq!(soft.outcome(&rows).unwrap(), "soft / base size=1024 ≤ 1.3: met on 1/2 scenes (1.20–1.50)");
         // No rows of `other`: that goal is left out of the table, not shown as failed.
         assert_eq!(goal("other").outcome(&rows), None);
-        let table = cost_goal_table(vec![goal("other"), soft.clone()], &rows);
+        let table = goal_table(COST_HEADING, vec![goal("other"), soft.clone()], &rows);
         assert!(!table.contains("other"), "{table}");
         for line in ["| a | 1.20 ✓ |", "| b | 1.50 ✗ |", "| c | |", "| met | 1/2 |"] {
             assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
         }
-        assert_eq!(cost_goal_table(vec![soft], &rows[..1]), "");
+        assert_eq!(goal_table(COST_HEADING, vec![soft], &rows[..1]), "");
+    }
+
+    #[test]
+    fn the_leak_rule_holds_where_the_centred_form_leaks_no_more_than_the_outer_only_one() {
+        let leaking = |scene: &str, setting: &str, leak_rate| BenchRow {
+            metrics: Metrics { leak_rate, ..Default::default() },
+            ..row(scene, "plateau", setting, 1.0)
+        };
+        let outer = "penumbra=0 falloff=0";
+        let rows = [
+            leaking("a", "", 0.0),
+            leaking("a", outer, 0.0),
+            leaking("b", "", 0.002),
+            leaking("b", outer, 0.001),
+            leaking("c", "", 0.001),
+            leaking("c", outer, 0.003),
+        ];
+        let plateau = leak_goals().into_iter().find(|g| g.technique == "plateau").expect("the plateau's leak rule");
+        assert_eq!((plateau.baseline, plateau.baseline_setting.as_str()), ("plateau", outer));
+        // Equal rates (none at all, say) meet it; a higher one does not.
+        assert_eq!(plateau.outcome(&rows).unwrap(), "plateau leaks ≤ plateau penumbra=0 falloff=0: met on 2/3 scenes");
+        let table = goal_table(LEAK_HEADING, vec![plateau], &rows);
+        for line in ["| a | 0.00000 vs 0.00000 ✓ |", "| b | 0.00200 vs 0.00100 ✗ |", "| met | 2/3 |"] {
+            assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
+        }
     }
 }
