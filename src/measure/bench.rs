@@ -129,8 +129,8 @@ pub fn leak_goals() -> Vec<Goal> {
         .collect()
 }
 
-/// A scene's (name, row's value, baseline's value) under one goal.
-pub type SceneValues<'a> = (&'a str, f64, f64);
+/// A scene's name, its row and its baseline row under one goal.
+pub type ScenePair<'a> = (&'a str, &'a BenchRow, &'a BenchRow);
 
 impl Goal {
     /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`
@@ -152,8 +152,8 @@ impl Goal {
         }
     }
 
-    /// Per scene holding both rows, (the row's value, the baseline's), in the rows' scene order.
-    pub fn values<'a>(&self, rows: &'a [BenchRow]) -> Vec<SceneValues<'a>> {
+    /// Per scene holding both rows, the row and its baseline, in the rows' scene order.
+    pub fn pairs<'a>(&self, rows: &'a [BenchRow]) -> Vec<ScenePair<'a>> {
         let find = |scene: &str, technique: &str, setting: &str| {
             rows.iter().find(|r| r.scene == scene && r.technique == technique && r.setting == setting)
         };
@@ -162,35 +162,38 @@ impl Goal {
             .filter_map(|scene| {
                 let of = find(scene, self.technique, &self.setting)?;
                 let base = find(scene, self.baseline, &self.baseline_setting)?;
-                Some((scene, self.value(of), self.value(base)))
+                Some((scene, of, base))
             })
             .collect()
     }
 
-    pub fn met(&self, of: f64, base: f64) -> bool {
+    pub fn met(&self, of: &BenchRow, base: &BenchRow) -> bool {
+        let (of, base) = (self.value(of), self.value(base));
         match self.measure {
             Measure::Cost { max_ratio } => of <= max_ratio * base,
             Measure::Leaks => of <= base,
         }
     }
 
-    /// A table cell: the ratio of a cost, both rates of a leak rule.
-    fn cell(&self, of: f64, base: f64) -> String {
+    /// A table cell: the ratio of a cost; a leak rule's leaking pixels, which rates of a few
+    /// in 10⁵ would hide.
+    fn cell(&self, of: &BenchRow, base: &BenchRow) -> String {
         let mark = if self.met(of, base) { "✓" } else { "✗" };
+        let leaking = |r: &BenchRow| (r.metrics.leak_rate * r.metrics.pixels as f64).round();
         match self.measure {
-            Measure::Cost { .. } => format!("{:.2} {mark}", of / base),
-            Measure::Leaks => format!("{of:.5} vs {base:.5} {mark}"),
+            Measure::Cost { .. } => format!("{:.2} {mark}", self.value(of) / self.value(base)),
+            Measure::Leaks => format!("{} vs {} px {mark}", leaking(of), leaking(base)),
         }
     }
 
     /// One line for the terminal, e.g. `smoothie / shadow-map … ≤ 1.3: met on 9/10 scenes
     /// (0.95–1.35)`; `None` when no scene has both rows.
     pub fn outcome(&self, rows: &[BenchRow]) -> Option<String> {
-        let values = self.values(rows);
-        let met = values.iter().filter(|(_, of, base)| self.met(*of, *base)).count();
+        let values = self.pairs(rows);
+        let met = values.iter().filter(|(_, of, base)| self.met(of, base)).count();
         let range = match self.measure {
             Measure::Cost { .. } => {
-                let ratios = values.iter().map(|(_, of, base)| of / base);
+                let ratios = values.iter().map(|(_, of, base)| self.value(of) / self.value(base));
                 let lo = ratios.clone().reduce(f64::min)?;
                 format!(" ({lo:.2}–{:.2})", ratios.reduce(f64::max)?)
             }
@@ -204,10 +207,10 @@ impl Goal {
 /// Goals as a table under `heading`, scene by scene, with how many scenes meet each; empty when
 /// no goal has both of its rows in `rows`.
 pub fn goal_table(heading: &str, goals: Vec<Goal>, rows: &[BenchRow]) -> String {
-    let goals: Vec<(Goal, Vec<SceneValues<'_>>)> = goals
+    let goals: Vec<(Goal, Vec<ScenePair<'_>>)> = goals
         .into_iter()
         .map(|g| {
-            let v = g.values(rows);
+            let v = g.pairs(rows);
             (g, v)
         })
         .filter(|(_, v)| !v.is_empty())
@@ -224,7 +227,7 @@ pub fn goal_table(heading: &str, goals: Vec<Goal>, rows: &[BenchRow]) -> String 
         let _ = write!(out, "| {scene} |");
         for (g, values) in &goals {
             match values.iter().find(|(s, ..)| *s == scene) {
-                Some(&(_, of, base)) => {
+                Some((_, of, base)) => {
                     let _ = write!(out, " {} |", g.cell(of, base));
                 }
                 None => out += " |",
@@ -234,7 +237,7 @@ pub fn goal_table(heading: &str, goals: Vec<Goal>, rows: &[BenchRow]) -> String 
     }
     out += "| met |";
     for (g, values) in &goals {
-        let met = values.iter().filter(|(_, of, base)| g.met(*of, *base)).count();
+        let met = values.iter().filter(|(_, of, base)| g.met(of, base)).count();
         let _ = write!(out, " {met}/{} |", values.len());
     }
     out + "\n\n"
@@ -492,7 +495,12 @@ mod tests {
         };
         let soft = goal("soft");
         // Scene c has no baseline row, so it has no ratio rather than a made-up one.
-        assert_eq!(soft.values(&rows), vec![("a", 6.0, 5.0), ("b", 6.0, 4.0)]);
+        let ratios: Vec<_> = soft
+            .pairs(&rows)
+            .iter()
+            .map(|(s, of, base)| (*s, of.timings.gpu_ms_total_median / base.timings.gpu_ms_total_median))
+            .collect();
+        assert_eq!(ratios, vec![("a", 1.2), ("b", 1.5)]);
         assert_eq!(soft.outcome(&rows).unwrap(), "soft / base size=1024 ≤ 1.3: met on 1/2 scenes (1.20–1.50)");
         // No rows of `other`: that goal is left out of the table, not shown as failed.
         assert_eq!(goal("other").outcome(&rows), None);
@@ -507,7 +515,7 @@ mod tests {
     #[test]
     fn the_leak_rule_holds_where_the_centred_form_leaks_no_more_than_the_outer_only_one() {
         let leaking = |scene: &str, setting: &str, leak_rate| BenchRow {
-            metrics: Metrics { leak_rate, ..Default::default() },
+            metrics: Metrics { leak_rate, pixels: 10_000, ..Default::default() },
             ..row(scene, "plateau", setting, 1.0)
         };
         let outer = "penumbra=0 falloff=0";
@@ -524,7 +532,7 @@ mod tests {
         // Equal rates (none at all, say) meet it; a higher one does not.
         assert_eq!(plateau.outcome(&rows).unwrap(), "plateau leaks ≤ plateau penumbra=0 falloff=0: met on 2/3 scenes");
         let table = goal_table(LEAK_HEADING, vec![plateau], &rows);
-        for line in ["| a | 0.00000 vs 0.00000 ✓ |", "| b | 0.00200 vs 0.00100 ✗ |", "| met | 2/3 |"] {
+        for line in ["| a | 0 vs 0 px ✓ |", "| b | 20 vs 10 px ✗ |", "| met | 2/3 |"] {
             assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
         }
     }
