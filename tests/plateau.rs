@@ -13,10 +13,11 @@ use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
 
-/// The wall's side edge stands at x = 0.05, 2.95 m from the light's foot (the light 0.5 m off
-/// the end face's plane, which faces away from it): at x on the ground behind it the physical
-/// penumbra is W = 2R·(0.05 − x)/2.95 across, growing from nothing at the wall's foot, and
-/// 0.02 < V < 0.98 holds over 0.9 W of the straight-edge profile.
+/// The wall's side edge stands at x = 0.05, 2.95 m short of the light's foot along x (the light
+/// 0.5 m off the end face's plane, which faces away from it): at x on the ground behind it the
+/// physical penumbra is W = 2R·(0.05 − x)/2.95 across (similar triangles along the shadow line),
+/// growing from nothing at the wall's foot, and 0.02 < V < 0.98 holds over 0.9 W of the
+/// straight-edge profile.
 #[test]
 fn the_penumbra_widens_with_height_vanishes_at_contact_and_keeps_a_dark_umbra() {
     let mut e = engine();
