@@ -39,8 +39,10 @@ float cross2(vec2 a, vec2 b) {
     return a.x * b.y - a.y * b.x;
 }
 
-// Slack of s and t at a sheet's sides (f32 rounding), as geometry::plateau::Sheet::at.
+// Slack of s and t at a sheet's sides (f32 rounding), and how near, relative to the patch's
+// size, a root near a fold line must map back, as geometry::plateau::Sheet::at.
 const float SHEET_SLACK = 1e-4;
+const float FOLD_SLACK = 1e-4;
 
 // A sheet's smallest t over this fragment and its foot's s on the hard edge: the inverse of the
 // bilinear map q = s·e + t·f + s·t·g (q = p − a), whose t solves (f × g)·t² + (f × e − q × g)·t −
@@ -49,26 +51,29 @@ bool sheet_t(out float t, out float s) {
     vec2 e = in_shape0.xy, f = in_shape0.zw, q = in_local;
     vec2 g = in_shape1.xy - f - e;
     float qa = cross2(f, g), qb = cross2(f, e) - cross2(q, g), qc = -cross2(q, e);
+    // Near a fold line d can round below 0 and s swings with t: a root there counts if it maps
+    // back to q (Sheet::at).
     float d = qb * qb - 4.0 * qa * qc;
-    if (d < 0.0) {
-        return false;
-    }
-    float h = -0.5 * (qb + (qb < 0.0 ? -sqrt(d) : sqrt(d)));
+    float root_d = sqrt(max(d, 0.0));
+    float h = -0.5 * (qb + (qb < 0.0 ? -root_d : root_d));
     float roots[2] = float[2](h != 0.0 ? qc / h : -1.0, qa != 0.0 ? h / qa : -1.0);
+    float reach2 = FOLD_SLACK * FOLD_SLACK * (dot(e, e) + dot(f, f) + dot(g, g));
     t = 2.0;
     for (int k = 0; k < 2; k++) {
         float r = roots[k];
-        if (r < -SHEET_SLACK || r > 1.0 || r >= t) {
+        if (r < -SHEET_SLACK || r > 1.0 + SHEET_SLACK || r >= t) {
             continue;
         }
         vec2 side = e + g * r;
         float u = dot(q - f * r, side) / dot(side, side);
-        if (u >= -SHEET_SLACK && u <= 1.0 + SHEET_SLACK) {
-            t = r;
-            s = clamp(u, 0.0, 1.0);
+        float rc = clamp(r, 0.0, 1.0), uc = clamp(u, 0.0, 1.0);
+        bool inside = d >= 0.0 && u >= -SHEET_SLACK && u <= 1.0 + SHEET_SLACK;
+        vec2 miss = e * uc + f * rc + g * (uc * rc) - q;
+        if (inside || dot(miss, miss) <= reach2) {
+            t = rc;
+            s = uc;
         }
     }
-    t = max(t, 0.0);
     return t <= 1.0;
 }
 
