@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{engine, finish, reference, render_with, top_down};
+use common::{crossing, engine, finish, reference, render_with, top_down};
 use softshadow::Capture;
 
 /// Half the ground seen, in metres: the camera looks straight down at (−4, 0, 0).
@@ -14,12 +14,6 @@ const HALF: f32 = 0.4;
 fn column(c: &Capture) -> Vec<(f32, f32)> {
     let to_z = |px: u32| -HALF + (px as f32 + 0.5) / c.height as f32 * 2.0 * HALF;
     (0..c.height).map(|px| (to_z(px), c.visibility_at(c.width / 2, px))).collect()
-}
-
-/// Where the profile first rises through V = `level`, interpolated.
-fn crossing(profile: &[(f32, f32)], level: f32) -> f32 {
-    let w = profile.windows(2).find(|w| w[0].1 < level && w[1].1 >= level).expect("a penumbra across the column");
-    w[0].0 + (level - w[0].1) / (w[1].1 - w[0].1) * (w[1].0 - w[0].0)
 }
 
 /// A wall 0.1 m thick along the light's direction, 1.2 m tall and 2 m across, under a light of
@@ -35,7 +29,8 @@ fn a_low_light_s_long_edge_has_the_true_penumbra_on_both_sides() {
     let mut e = engine();
     let truth = column(&reference(&mut e, &s, 128));
     let widths = |p: &[(f32, f32)]| {
-        let (start, middle, end) = (crossing(p, 0.05), crossing(p, 0.5), crossing(p, 0.95));
+        let at = |level| crossing(p, level).expect("a penumbra across the column");
+        let (start, middle, end) = (at(0.05), at(0.5), at(0.95));
         (middle, middle - start, end - middle)
     };
     let (true_edge, true_inner, true_outer) = widths(&truth);

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{engine, error_minimising_scale, finish, reference, render_with, suite_scene, terminator_error};
+use common::{crossing, engine, error_minimising_scale, finish, reference, render_with, suite_scene, terminator_error};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -29,14 +29,6 @@ fn strip(height: f32, radius: f32, (centre, half): (f32, f32)) -> Scene {
 fn row(c: &Capture, (centre, half): (f32, f32)) -> Vec<(f32, f32)> {
     let to_x = |px: u32| centre - half + (px as f32 + 0.5) / c.width as f32 * 2.0 * half;
     (0..c.width).map(|px| (to_x(px), c.visibility_at(px, c.height / 2))).collect()
-}
-
-/// Where the profile crosses V = `level` going right, interpolated.
-fn crossing(profile: &[(f32, f32)], level: f32) -> Option<f32> {
-    profile.windows(2).find(|w| w[0].1 < level && w[1].1 >= level).map(|w| {
-        let f = (level - w[0].1) / (w[1].1 - w[0].1);
-        w[0].0 + f * (w[1].0 - w[0].0)
-    })
 }
 
 #[test]

@@ -94,6 +94,14 @@ pub fn wall_edge_width(c: &Capture, x: u32) -> usize {
     (WALL_SIZE / 2..WALL_SIZE).filter(|&y| (0.02..0.98).contains(&c.visibility_at(x, y))).count()
 }
 
+/// Where a profile of (position, V) first rises through V = `level`, interpolated.
+pub fn crossing(profile: &[(f32, f32)], level: f32) -> Option<f32> {
+    profile.windows(2).find(|w| w[0].1 < level && w[1].1 >= level).map(|w| {
+        let f = (level - w[0].1) / (w[1].1 - w[0].1);
+        w[0].0 + f * (w[1].0 - w[0].0)
+    })
+}
+
 /// Renders `technique` with knobs `sets` at `size`², and reads the frame back.
 pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &str)], size: u32) -> Capture {
     let mut frame = settings(s, size, size);
