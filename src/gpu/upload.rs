@@ -29,27 +29,51 @@ pub fn upload(
 /// error while recording, or an embedder's discarded frame) never ran its copies: what it
 /// uploaded is made again when next asked for ([`Context::upload_kept`]), and the old copy
 /// retired (an embedder may have submitted a failed frame's command buffer all the same).
+/// Data the last frame that asked for any did not ask for is retired as the next one asks,
+/// as the renderer's mesh cache drops meshes no frame draws: a loop streaming meshes (level
+/// after level) keeps only those it still draws.
 pub struct Uploads<K, T> {
-    /// Key, when it was uploaded, and the data.
-    items: Vec<(K, UploadMark, T)>,
+    items: Vec<Upload<K, T>>,
+    /// The frame that asked last ([`Context::frames_recorded`] while it was recorded).
+    asked_in: Option<u64>,
     destroy: fn(T, &Context),
+}
+
+struct Upload<K, T> {
+    key: K,
+    /// When it was uploaded.
+    mark: UploadMark,
+    /// The frame that asked for it last.
+    asked_in: u64,
+    data: T,
 }
 
 impl<K: PartialEq, T: 'static> Uploads<K, T> {
     pub fn new(destroy: fn(T, &Context)) -> Self {
-        Uploads { items: Vec::new(), destroy }
+        Uploads { items: Vec::new(), asked_in: None, destroy }
     }
 
     /// The index of `key`'s data, made by `make` (recording its upload into this frame) when
-    /// absent or lost. Indices stay valid while the `Uploads` lives.
+    /// absent or lost. Indices stay valid until a later frame asks for any.
     pub fn index(&mut self, ctx: &Context, key: K, make: impl FnOnce() -> Result<T>) -> Result<usize> {
-        let Some(at) = self.items.iter().position(|(k, _, _)| *k == key) else {
-            self.items.push((key, ctx.upload_mark(), make()?));
+        let frame = ctx.frames_recorded();
+        if let Some(last) = self.asked_in.filter(|&last| last != frame) {
+            // Retired, not destroyed: the frames recorded so far may still use it.
+            for stale in self.items.extract_if(.., |u| u.asked_in != last) {
+                let destroy = self.destroy;
+                ctx.retire(move |ctx| destroy(stale.data, ctx));
+            }
+        }
+        self.asked_in = Some(frame);
+        let Some(at) = self.items.iter().position(|u| u.key == key) else {
+            self.items.push(Upload { key, mark: ctx.upload_mark(), asked_in: frame, data: make()? });
             return Ok(self.items.len() - 1);
         };
-        if !ctx.upload_kept(self.items[at].1) {
-            let old = std::mem::replace(&mut self.items[at].2, make()?);
-            self.items[at].1 = ctx.upload_mark();
+        let item = &mut self.items[at];
+        item.asked_in = frame;
+        if !ctx.upload_kept(item.mark) {
+            let old = std::mem::replace(&mut item.data, make()?);
+            item.mark = ctx.upload_mark();
             let destroy = self.destroy;
             ctx.retire(move |ctx| destroy(old, ctx));
         }
@@ -57,15 +81,15 @@ impl<K: PartialEq, T: 'static> Uploads<K, T> {
     }
 
     pub fn get(&self, index: usize) -> &T {
-        &self.items[index].2
+        &self.items[index].data
     }
 
     pub fn get_mut(&mut self, index: usize) -> &mut T {
-        &mut self.items[index].2
+        &mut self.items[index].data
     }
 
     pub fn destroy(self, ctx: &Context) {
-        self.items.into_iter().for_each(|(_, _, data)| (self.destroy)(data, ctx));
+        self.items.into_iter().for_each(|u| (self.destroy)(u.data, ctx));
     }
 }
 
@@ -153,9 +177,9 @@ mod tests {
 
     /// Data a frame uploads is kept while frames are submitted (and within its own frame), and
     /// made again once a frame is lost: begun and never submitted, as on an error, or recorded
-    /// into an embedder's command buffer and discarded.
+    /// into an embedder's command buffer and discarded; or once a frame asked for other data.
     #[test]
-    fn what_a_lost_frame_uploaded_is_made_again() {
+    fn what_a_lost_frame_uploaded_or_a_later_frame_left_is_made_again() {
         let mut ctx = Context::headless(&ContextOptions { validation: true, device: None }).unwrap();
         let mut ring = FrameRing::new(&ctx).unwrap();
         let mut uploads: Uploads<u32, Buffer> = Uploads::new(Buffer::destroy);
@@ -183,6 +207,11 @@ mod tests {
         // Frame 3 was lost: its upload is made again, and, no earlier upload being trusted, 1's.
         assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "not made again after a lost frame");
         assert_eq!(frame(&ctx, &mut ring, &[2, 1], true), 4, "made again after frames were submitted");
+        // What the last frame that asked did not ask for goes; frames asking nothing keep all.
+        assert_eq!(frame(&ctx, &mut ring, &[2], true), 4);
+        assert_eq!(frame(&ctx, &mut ring, &[], true), 4);
+        assert_eq!(frame(&ctx, &mut ring, &[2], true), 4, "made again across a frame that asked for nothing");
+        assert_eq!(frame(&ctx, &mut ring, &[1], true), 5, "kept after a frame that did not ask for it");
         ring.drain(&ctx).unwrap();
         uploads.destroy(&ctx);
         ring.destroy(&ctx);

@@ -105,8 +105,8 @@ impl MeshBuffers {
 }
 
 /// The frame's casters as a pass that casts their shadows draws them: each from the mesh its
-/// shadow is cast from, the simplified one uploaded once (per mesh, while it lives) where it is
-/// not the object's own.
+/// shadow is cast from, the simplified one uploaded once (per mesh, while frames draw it) where
+/// it is not the object's own.
 pub struct CasterMeshes {
     uploads: Uploads<MeshId, MeshBuffers>,
     /// Per casting draw of this frame, in draw order: the upload it draws (`None`: its own

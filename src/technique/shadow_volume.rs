@@ -232,8 +232,10 @@ impl ShadowVolumes {
         if o.receives { o.mesh.clone() } else { shadow_mesh(o, light, params) }
     }
 
-    /// What every caster's mesh needs, found the first time it is seen.
+    /// What every caster's mesh needs, found the first time it is seen; forgotten once no
+    /// caster casts from it.
     fn learn_meshes(&mut self, meshes: &[Option<Arc<Mesh>>]) {
+        self.facts.retain(|(id, _)| meshes.iter().flatten().any(|m| m.id() == *id));
         for m in meshes.iter().flatten() {
             if self.facts.iter().any(|(id, _)| *id == m.id()) {
                 continue;

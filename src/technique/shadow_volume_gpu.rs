@@ -5,9 +5,9 @@
 //! group (sides, caps, turned caps), which the counting passes draw. The vertices are the CPU
 //! path's, and so is the facing test (the mesh's face planes against the light taken into
 //! object space on the host, the same operations in the same order), so the counts, and V, are
-//! the same. Each mesh's positions, triangles, edges and face planes are uploaded once; the
-//! vertex buffer and the draw commands hold one copy of one point's volumes, rebuilt for the
-//! next. With one point (hard shadows) they are kept while neither the casters nor the light
+//! the same. Each mesh's positions, triangles, edges and face planes are uploaded once, while
+//! it is drawn; the vertex buffer and the draw commands hold one copy of one point's volumes,
+//! rebuilt for the next. With one point (hard shadows) they are kept while neither the casters nor the light
 //! moved: a static scene records no silhouette work after its first frame. Accumulating
 //! several points rebuilds each one's every frame (one point's volumes of a 100k-triangle
 //! caster take tens of megabytes).
