@@ -1,6 +1,6 @@
 #version 460
 // Plateau resolve: receivers on the plane read the plateau texture where they stand; V is the
-// falloff curve at the plateau parameter t (Haines §3: a 1D texture turns t into the gradient).
+// falloff curve at the plateau parameter t (Haines §3: the curve turns t into the gradient).
 // Outer only (the paper), t is 0 under the hard shadow mask. Centred (issue 20), t is the
 // distance to the hard edge in half widths, signed by the mask (negative inside), and the curve
 // spans the whole width: V = falloff(½ + ½·s), ½ on the hard edge, in each of two channels
@@ -22,7 +22,6 @@ layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D plateau_texture;
 layout(set = 0, binding = 5) uniform sampler2D umbra_mask;
-layout(set = 0, binding = 6) uniform sampler2D falloff;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
@@ -44,9 +43,9 @@ vec2 texel_s(vec2 t, uint caster) {
 }
 
 // A channel's visibility: every curve maps 0 to 0 and 1 to 1, so lit and umbra channels (most
-// of the frame) skip the falloff texture.
+// of the frame) skip the curve.
 float channel_v(float s) {
-    return s >= 1.0 ? 1.0 : (s <= -1.0 ? 0.0 : falloff_at(falloff, FALLOFF, 0.5 + 0.5 * s));
+    return s >= 1.0 ? 1.0 : (s <= -1.0 ? 0.0 : falloff_at(0.5 + 0.5 * s));
 }
 
 // Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
@@ -108,5 +107,5 @@ void main() {
     }
     vec2 signed_t = plateau_s(tc);
     // Centred, the two channels' blockers count as independent: their visibilities multiply.
-    out_visibility = CENTRED ? channel_v(signed_t.x) * channel_v(signed_t.y) : falloff_at(falloff, FALLOFF, signed_t.x);
+    out_visibility = CENTRED ? channel_v(signed_t.x) * channel_v(signed_t.y) : falloff_at(signed_t.x);
 }

@@ -25,7 +25,6 @@ layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D shadow_map;
 layout(set = 0, binding = 5) uniform sampler2D smoothies; // b, α'; centred: also α, 1 − b inside (depth.glsl codes)
-layout(set = 0, binding = 6) uniform sampler2D falloff;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
@@ -103,7 +102,7 @@ float centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     float slack = 2.0 * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / map_size;
     vec4 in_front = t.behind * vec4(lessThan(t.b, depth_code(light, caster * (1.0 - slack))));
     vec4 shadowed = (0.5 - 0.5 * a) * mix(vec4(1.0), lit, in_front);
-    return falloff_at(falloff, FALLOFF, bilinear(t.f, mix(lit, shadowed, vec4(lessThan(caster, vec4(depth))))));
+    return falloff_at(bilinear(t.f, mix(lit, shadowed, vec4(lessThan(caster, vec4(depth))))));
 }
 
 // Whether V at this lookup can differ from the hard test's: an alpha below 1 among the four
@@ -153,11 +152,11 @@ void main() {
         return;
     }
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
-    // falloff texture.
+    // curve.
     if (CENTRED) {
         out_visibility = min(self_lit, centred_test(l.uv, l.depth, umbra, map));
         return;
     }
     float v = umbra > 0.0 ? min(umbra, outer_test(l.uv, l.depth)) : 0.0;
-    out_visibility = min(self_lit, v > 0.0 && v < 1.0 ? falloff_at(falloff, FALLOFF, v) : v);
+    out_visibility = min(self_lit, v > 0.0 && v < 1.0 ? falloff_at(v) : v);
 }

@@ -6,8 +6,9 @@
 //! cone at each silhouette vertex (`cones`) and a sheet along each silhouette edge (`sheets`)
 //! form the plateau's sides in a second texture, cleared to t = 1 and drawn with depth = t so
 //! the darkest wins; `resolve` reads both where each receiver stands and turns t into V through
-//! a 1D falloff texture (§3). The paper draws the umbra into the plateau texture itself at
-//! t = 0; kept apart, the same mask also gives the centred penumbra its sign.
+//! the falloff curve (§3's 1D texture, computed in the shader instead, `glsl/common/falloff.glsl`).
+//! The paper draws the umbra into the plateau texture itself at t = 0; kept apart, the same mask
+//! also gives the centred penumbra its sign.
 //!
 //! Penumbra size. Physically, a vertex at height h casts the footprint of the cone of rays from
 //! it to the light sphere (width W = D·h/(H − h) under a light overhead, stretched into an
@@ -64,7 +65,7 @@ use ash::vk;
 use bytemuck::{bytes_of, cast_slice};
 use glam::{Mat4, Vec2, Vec4};
 
-use super::falloff::{FALLOFF, Falloff, PENUMBRA};
+use super::falloff::{FALLOFF, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map;
@@ -227,7 +228,6 @@ pub struct Plateau {
     texture: Option<Target>,
     mask: Option<Target>,
     depth: Option<Target>,
-    falloff: Falloff,
     /// Per scene object: the sides last built and what they were built from.
     sides: Vec<Option<CasterSides>>,
     /// The meshes the umbra pass draws: the sides' (`shadow_mesh_error`).
@@ -267,7 +267,6 @@ impl Plateau {
             texture: None,
             mask: None,
             depth: None,
-            falloff: Falloff::default(),
             sides: Vec::new(),
             casters: CasterMeshes::default(),
         })
@@ -386,7 +385,6 @@ impl Technique for Plateau {
             buffer.write(frame.slot, &[cones, sheets].concat());
         }
         let cmd = frame.cmd;
-        let falloff = self.falloff.texture(ctx, cmd)?;
 
         // The umbra is the casters' hard shadow: drawn from the meshes the sides came from, the
         // simplified shadow meshes where `shadow_mesh_error` asks for them (their uploads recorded
@@ -446,12 +444,9 @@ impl Technique for Plateau {
             frame.timer.end(ctx, cmd);
         }
 
-        transition(ctx, cmd, &mut [(texture, Access::FRAGMENT_READ, false), (falloff, Access::FRAGMENT_READ, false)]);
-        let inputs = [
-            &surface_inputs(frame, view_range)[..],
-            &[Descriptor::Image(texture), Descriptor::Image(mask), Descriptor::Image(falloff)],
-        ]
-        .concat();
+        transition(ctx, cmd, &mut [(texture, Access::FRAGMENT_READ, false)]);
+        let inputs =
+            [&surface_inputs(frame, view_range)[..], &[Descriptor::Image(texture), Descriptor::Image(mask)]].concat();
         let format = self.visibility;
         let key = (params.get(&CURVE) as u32, params.is_on(&OFF_PLANE), centred);
         let pipeline = self.resolves.get(key, |&(curve, off_plane, centred)| {
@@ -469,7 +464,6 @@ impl Technique for Plateau {
         this.resolves.destroy(ctx);
         this.view.destroy(ctx);
         this.primitives.into_iter().for_each(|b| b.destroy(ctx));
-        this.falloff.destroy(ctx);
         this.casters.destroy(ctx);
         this.texture.into_iter().chain(this.mask).chain(this.depth).for_each(|t| t.destroy(ctx));
     }

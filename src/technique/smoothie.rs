@@ -53,7 +53,7 @@ use ash::vk;
 use bytemuck::cast_slice;
 use glam::{Mat4, Vec3, Vec4};
 
-use super::falloff::{FALLOFF, Falloff, PENUMBRA};
+use super::falloff::{FALLOFF, PENUMBRA};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
@@ -321,7 +321,6 @@ pub struct Smoothie {
     visibility: vk::Format,
     vertices: Option<PerFrame>,
     buffer: Option<Target>,
-    falloff: Falloff,
     silhouettes: Vec<Option<CasterSilhouette>>,
     /// The meshes the shadow map draws: the smoothies' own (`shadow_mesh_error`).
     casters: CasterMeshes,
@@ -341,7 +340,6 @@ impl Smoothie {
             visibility,
             vertices: None,
             buffer: None,
-            falloff: Falloff::default(),
             silhouettes: Vec::new(),
             casters: CasterMeshes::default(),
             gpu: None,
@@ -487,7 +485,6 @@ impl Technique for Smoothie {
             Pipeline::new(ctx, &desc)
         })?;
         let cmd = frame.cmd;
-        let falloff = self.falloff.texture(ctx, cmd)?;
         let buffer = self.buffer.as_mut().expect("ensured");
         let (map, light) = self.pass.inputs(frame.slot);
 
@@ -505,13 +502,8 @@ impl Technique for Smoothie {
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
-        let readable = Access::FRAGMENT_READ;
-        transition(ctx, cmd, &mut [(buffer, readable, false), (falloff, readable, false)]);
-        let inputs = [
-            &surface_inputs(frame, light)[..],
-            &[Descriptor::Image(map), Descriptor::Image(buffer), Descriptor::Image(falloff)],
-        ]
-        .concat();
+        transition(ctx, cmd, &mut [(buffer, Access::FRAGMENT_READ, false)]);
+        let inputs = [&surface_inputs(frame, light)[..], &[Descriptor::Image(map), Descriptor::Image(buffer)]].concat();
         // One frustum for both: equal sizes put the buffer's texels on the map's.
         let key = (params.get(&SMOOTHIE_FALLOFF) as u32, centred, buffer_size == size);
         self.resolve.record(frame, self.visibility, key, visibility, &inputs)
@@ -524,7 +516,6 @@ impl Technique for Smoothie {
         this.resolve.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
         this.buffer.into_iter().for_each(|t| t.destroy(ctx));
-        this.falloff.destroy(ctx);
         this.casters.destroy(ctx);
         this.gpu.into_iter().for_each(|g| g.destroy(ctx));
     }
