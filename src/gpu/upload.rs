@@ -56,11 +56,10 @@ impl<K: PartialEq, T: 'static> Uploads<K, T> {
     /// The index of `key`'s data, made by `make` (recording its upload into this frame) when
     /// absent or lost. Indices stay valid until a later frame asks for any.
     pub fn index(&mut self, ctx: &Context, key: K, make: impl FnOnce() -> Result<T>) -> Result<usize> {
-        let frame = ctx.frames_recorded();
+        let (frame, destroy) = (ctx.frames_recorded(), self.destroy);
         if let Some(last) = self.asked_in.filter(|&last| last != frame) {
             // Retired, not destroyed: the frames recorded so far may still use it.
             for stale in self.items.extract_if(.., |u| u.asked_in != last) {
-                let destroy = self.destroy;
                 ctx.retire(move |ctx| destroy(stale.data, ctx));
             }
         }
@@ -74,7 +73,6 @@ impl<K: PartialEq, T: 'static> Uploads<K, T> {
         if !ctx.upload_kept(item.mark) {
             let old = std::mem::replace(&mut item.data, make()?);
             item.mark = ctx.upload_mark();
-            let destroy = self.destroy;
             ctx.retire(move |ctx| destroy(old, ctx));
         }
         Ok(at)
