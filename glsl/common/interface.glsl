@@ -62,7 +62,8 @@ struct SilhouetteParams {
     vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver;
                       // y, w: the caster's light-depth range (inner quads)
     uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices, w: 1 for inner quads
-    vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE)
+    vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE);
+                      // y: the caster's channel in the centred smoothie buffer (0 or 1)
     vec4 pad[9];
 };
 

@@ -24,4 +24,14 @@ vec4 code_depth(LightView light, vec4 code) {
     return light.depths.x * exp2(code * light.depths.z);
 }
 
+// Depth along the light's ray through `uv` (the light view's window, [0, 1]²) where it meets
+// the ground plane (kernel.z: its height, kernel.w: the light's), infinite when it does not:
+// view-space rays (x/z, y/z, 1) advance one unit of depth per unit of z.
+float ground_depth(LightView light, vec2 uv) {
+    vec2 tangent = mix(light.extent.xy, light.extent.zw, uv);
+    // World y of the ray (x/z, y/z, 1): the view matrix's rows are the light's axes.
+    float down = dot(vec3(tangent, 1.0), light.view[1].xyz);
+    return down < 0.0 ? (light.kernel.z - light.kernel.w) / down : 1.0 / 0.0;
+}
+
 #endif

@@ -18,9 +18,10 @@ layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
 layout(std430, set = 0, binding = 5) buffer Args { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
-// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w (src/geometry/smoothie.rs's SmoothieVertex)
+// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel (src/geometry/smoothie.rs's
+// SmoothieVertex)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
-const uint FLOATS = 12u;
+const uint FLOATS = 13u;
 
 vec3 view_position(uint v) {
     return (params.model_view * vec4(positions[v].xyz, 1.0)).xyz;
@@ -53,7 +54,7 @@ struct Inner {
 };
 
 void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 range, float w) {
-    float v[12] = float[12](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y, w);
+    float v[13] = float[13](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y, w, params.light.y);
     for (uint k = 0u; k < FLOATS; k++) {
         vertices[FLOATS * at + k] = v[k];
     }

@@ -11,12 +11,14 @@ layout(location = 2) in vec2 in_foot;          // inner quads: the edge's point,
 layout(location = 3) in vec2 in_normal;        // inner quads: the edge's outward normal
 layout(location = 4) in vec2 in_range;         // inner quads: the caster's depth range; 0: outer
 layout(location = 5) in float in_w;            // projective weight 1/t: edges' alpha exact (SmoothieVertex::w)
+layout(location = 6) in float in_channel;      // centred: the caster's channel, 0 or 1
 
 // Linear in the buffer but the alpha (`shape`), which w makes distance over size.
 layout(location = 0) noperspective out float out_b;
 layout(location = 1) out vec2 out_shape;
 layout(location = 2) noperspective out vec2 out_probe;
 layout(location = 3) flat out vec2 out_range;
+layout(location = 4) flat out float out_channel;
 
 vec2 to_uv(vec2 tangent) {
     return (tangent - light.extent.xy) / (light.extent.zw - light.extent.xy);
@@ -31,5 +33,6 @@ void main() {
     vec2 texel = (light.extent.zw - light.extent.xy) / light.bias.w;
     out_probe = to_uv(in_foot + in_normal * 1.5 * max(texel.x, texel.y));
     out_range = in_range;
+    out_channel = in_channel;
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0) * in_w;
 }

@@ -75,7 +75,8 @@ pub struct SilhouetteParams {
     pub model_view: Mat4,
     pub size: Vec4,
     pub counts: [u32; 4],
-    /// x: how far the light lies behind the view's origin.
+    /// x: how far the light lies behind the view's origin; y: the caster's channel in the
+    /// centred smoothie buffer (`SmoothieVertex::channel`).
     pub light: Vec4,
     pub pad: [Vec4; 9],
 }

@@ -60,6 +60,9 @@ pub struct SmoothieVertex {
     /// correct interpolation of α gives Σλd / Σλt, exact for the quad's affine d and t.
     /// Corners have one t: any constant does.
     pub w: f32,
+    /// Which of the centred buffer's two channels the caster's smoothies go to (0 or 1, by
+    /// the parity of its number; see [`SmoothieGeometry::in_channel`]).
+    pub channel: f32,
 }
 
 /// Which side of the hard edge the smoothies cover (the `penumbra` knob).
@@ -129,6 +132,17 @@ impl SmoothieGeometry {
         self.edges.is_empty() && self.corners.is_empty() && self.inner.is_empty()
     }
 
+    /// The same smoothies in the centred smoothie buffer's channel for caster number `number`,
+    /// its parity: two casters' penumbrae multiply where they cross instead of the darker
+    /// winning, unless their numbers have the same parity (`glsl/smoothie/centred.frag`).
+    pub fn in_channel(mut self, number: u32) -> Self {
+        let c = (number % 2) as f32;
+        for v in self.edges.iter_mut().chain(&mut self.corners).chain(&mut self.inner) {
+            v.channel = c;
+        }
+        self
+    }
+
     /// Every vertex, in drawing order.
     pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
         self.edges.iter().chain(&self.corners).chain(&self.inner)
@@ -156,6 +170,7 @@ fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
         near: 0.0,
         far: 0.0,
         w: 1.0,
+        channel: 0.0,
     }
 }
 

@@ -5,7 +5,7 @@
 //! in R32F or the paper's 16-bit float), `smoothie_buffer` (the smoothie edges and corners drawn
 //! from the light into depth b and remapped alpha α' = α / (1 − b/r) at once, packed in one
 //! 16-bit two-channel target with minimum blending, b as a logarithmic code: see
-//! [`smoothie_format`]), `resolve` (the two depth comparisons at the four nearest texels, then
+//! [`smoothie_formats`]), `resolve` (the two depth comparisons at the four nearest texels, then
 //! the falloff; in two draws, the second only where a smoothie is near: see
 //! [`MaskedResolve::record`]).
 //!
@@ -19,10 +19,10 @@
 //!
 //! Penumbra (issue 20, the `penumbra` knob): the paper's smoothies grow outward only, so the
 //! whole hard shadow stays umbra and a physical size only darkens (§3). Centred, each edge also
-//! gets an inner quad over its blocker (`geometry::smoothie`), drawn into two more channels of
-//! the smoothie buffer (α and 1 − b, minimum-blended too: the shallowest inner alpha, as
-//! the blocker is the intersection of its edges' half planes, and the farthest inner depth,
-//! which errs dark), the resolve maps the distance over the whole
+//! gets an inner quad over its blocker (`geometry::smoothie`), drawn into more channels of the
+//! smoothie buffer (α and, in a second target, 1 − b, minimum-blended too: the shallowest inner
+//! alpha, as the blocker is the intersection of its edges' half planes, and the farthest inner
+//! depth, which errs dark), the resolve maps the distance over the whole
 //! width, t = ½ ± ½α' on the lit and the shadowed side, through the
 //! falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light grows, vanishing
 //! once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
@@ -30,6 +30,16 @@
 //! outside the edge: no fold of the same caster, no other caster there) and the map's blocker at
 //! the fragment is that caster (its depth inside the caster's range): one caster's inner half
 //! never lightens what another blocks, and interior silhouettes (folds) stay umbra.
+//!
+//! Overlapping casters, centred: each caster's α' goes to one of two channels by the parity of
+//! its number, and the resolve multiplies the two channels' visibilities (as the plateau's
+//! resolve does), so where two casters' penumbrae cross, the light each hides counts as
+//! independent of the other's instead of the darker alone winning (the paper's minimum
+//! blending, §3.1, which left V ½ where the truth is about ¼). And a smoothie behind the map's
+//! caster is kept (the paper drops it as hidden, Figure 11): in that caster's inner penumbra the
+//! receiver sees part of the light, which the caster behind may hide too, so there it counts as
+//! another blocker in the channel the inner half is not in. Together they took the leaking
+//! pixels on overlap and two_boxes from 90 and 51 to 0 (512², against the reference).
 //!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard
@@ -198,18 +208,22 @@ const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 const MASK_FORMAT: vk::Format = vk::Format::D16_UNORM;
 /// The largest finite 16-bit float.
 const HALF_MAX: f32 = 65504.0;
-/// The smoothie buffer: depth b (as a code in [0, 1], glsl/smoothie/depth.glsl) and remapped
-/// alpha α' of the outer smoothies; centred, also α and 1 − b of the inner quads (minimum
-/// blending keeps the shallowest inner alpha, the farthest inner depth). Unsigned normalized
-/// 16-bit channels where the device blends into them (Vulkan does not require it), else 32-bit
-/// floats holding the same codes.
-fn smoothie_format(ctx: &Context, centred: bool) -> vk::Format {
-    let (unorm, float) = if centred {
-        (vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT)
+/// The smoothie buffer's targets. Outer only: depth b (as a code in [0, 1],
+/// glsl/smoothie/depth.glsl) and remapped alpha α'. Centred: b, α' of the even and of the odd
+/// casters, the inner quads' α (with their channel), and in a second target their 1 − b
+/// (glsl/smoothie/centred.frag). Minimum blending throughout. Unsigned normalized 16-bit
+/// channels where the device blends into them (Vulkan does not require it), else 32-bit floats
+/// holding the same codes.
+fn smoothie_formats(ctx: &Context, centred: bool) -> Vec<vk::Format> {
+    let pick = |unorm, float| if ctx.renders_blended(unorm) { unorm } else { float };
+    if centred {
+        vec![
+            pick(vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT),
+            pick(vk::Format::R16_UNORM, vk::Format::R32_SFLOAT),
+        ]
     } else {
-        (vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)
-    };
-    if ctx.renders_blended(unorm) { unorm } else { float }
+        vec![pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)]
+    }
 }
 
 /// A resolve pipeline's specialization: falloff curve, centred, same grid.
@@ -314,13 +328,14 @@ pub struct Smoothie {
     pass: ShadowMapPass,
     /// The smoothie pass, by centring (the buffer's format).
     smoothie: Variants<bool>,
-    /// The smoothie buffer's format, outer only and centred.
-    buffer_formats: [vk::Format; 2],
+    /// The smoothie buffer's formats, outer only and centred.
+    buffer_formats: [Vec<vk::Format>; 2],
     resolve: MaskedResolve,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     vertices: Option<PerFrame>,
-    buffer: Option<Target>,
+    /// The smoothie buffer and, centred, the inner quads' depths.
+    buffer: [Option<Target>; 2],
     silhouettes: Vec<Option<CasterSilhouette>>,
     /// The meshes the shadow map draws: the smoothies' own (`shadow_mesh_error`).
     casters: CasterMeshes,
@@ -335,11 +350,11 @@ impl Smoothie {
         Ok(Smoothie {
             pass: pass.keep(),
             smoothie: Variants::default(),
-            buffer_formats: [smoothie_format(ctx, false), smoothie_format(ctx, true)],
+            buffer_formats: [smoothie_formats(ctx, false), smoothie_formats(ctx, true)],
             resolve: MaskedResolve::default(),
             visibility,
             vertices: None,
-            buffer: None,
+            buffer: [None, None],
             silhouettes: Vec::new(),
             casters: CasterMeshes::default(),
             gpu: None,
@@ -360,11 +375,14 @@ impl Smoothie {
         let light = frame.scene.light.position;
         self.silhouettes.resize_with(objects.len(), || None);
         let mut out = SmoothieGeometry::default();
+        let mut number = 0;
         for ((o, mesh), cached) in objects.iter().zip(cast).zip(&mut self.silhouettes) {
             let Some(mesh) = mesh else {
                 *cached = None;
                 continue;
             };
+            // Casters numbered as the compute path numbers them: those that cast, in order.
+            number += 1;
             let o = &Object { mesh: mesh.clone(), ..o.clone() };
             let model = o.transform.matrix();
             let key = SilhouetteKey { mesh: o.mesh.id(), model, light };
@@ -381,12 +399,13 @@ impl Smoothie {
             let c = cached.as_ref().expect("set above");
             let view = *view * model;
             let penumbra = penumbra(centred, &view, &o.mesh.bounds);
-            if tolerance > 0.0 {
+            let geometry = if tolerance > 0.0 {
                 let merged = merged_silhouette(&view, &caster, &c.edges, (size, far), tolerance);
-                out.extend(&merged_smoothies(&view, &caster, &merged, (size, far), penumbra));
+                merged_smoothies(&view, &caster, &merged, (size, far), penumbra)
             } else {
-                out.extend(&smoothies(&view, &caster, &c.edges, (size, far), penumbra));
-            }
+                smoothies(&view, &caster, &c.edges, (size, far), penumbra)
+            };
+            out.extend(&geometry.in_channel(number));
         }
         out
     }
@@ -470,29 +489,29 @@ impl Technique for Smoothie {
             }
         };
 
-        let buffer_format = self.buffer_formats[usize::from(centred)];
-        ensure(ctx, &mut self.buffer, TargetDesc::color("smoothie buffer", buffer_format, buffer_size, buffer_size))?;
-        let smoothie = self.smoothie.get(centred, |_| {
-            let formats = [buffer_format];
-            let desc = PipelineDesc::new(
-                "smoothie_buffer",
-                &shaders::SMOOTHIE_SMOOTHIE_VERT,
-                &shaders::SMOOTHIE_SMOOTHIE_FRAG,
-            )
-            .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1]))
-            .colors(&formats)
-            .blend(Blend::Min);
+        let formats = &self.buffer_formats[usize::from(centred)];
+        for ((target, &format), name) in self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner depths"]) {
+            ensure(ctx, target, TargetDesc::color(name, format, buffer_size, buffer_size))?;
+        }
+        let smoothie = self.smoothie.get(centred, |&centred| {
+            let fragment = if centred { &shaders::SMOOTHIE_CENTRED_FRAG } else { &shaders::SMOOTHIE_SMOOTHIE_FRAG };
+            let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, fragment)
+                .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1]))
+                .colors(formats)
+                .blend(Blend::Min);
             Pipeline::new(ctx, &desc)
         })?;
         let cmd = frame.cmd;
-        let buffer = self.buffer.as_mut().expect("ensured");
         let (map, light) = self.pass.inputs(frame.slot);
+        let targets = &mut self.buffer[..formats.len()];
 
         frame.timer.begin(ctx, cmd, "smoothie_buffer");
-        transition(ctx, cmd, &mut [(buffer, Access::COLOR_WRITE, true)]);
-        // What minimum blending leaves where no smoothie is: the farthest depth code, alpha 1, and
-        // an inner alpha of 1 (umbra, as no inner quad).
-        let pass = RenderPass::begin(ctx, cmd, &[Attachment::clear_color(buffer, [1.0; 4])], None);
+        let mut writes: Vec<_> = targets.iter_mut().flatten().map(|t| (t, Access::COLOR_WRITE, true)).collect();
+        transition(ctx, cmd, &mut writes);
+        // What minimum blending leaves where no smoothie is: the farthest depth code, alphas of
+        // 1, an inner alpha of 1 (umbra, as no inner quad) and the nearest inner depth.
+        let clears: Vec<_> = targets.iter().flatten().map(|t| Attachment::clear_color(t, [1.0; 4])).collect();
+        let pass = RenderPass::begin(ctx, cmd, &clears, None);
         smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)])?;
         match source {
             Smoothies::Direct { vertices, count } => draw_vertices(ctx, cmd, vertices, 0, count),
@@ -502,8 +521,16 @@ impl Technique for Smoothie {
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
-        transition(ctx, cmd, &mut [(buffer, Access::FRAGMENT_READ, false)]);
-        let inputs = [&surface_inputs(frame, light)[..], &[Descriptor::Image(map), Descriptor::Image(buffer)]].concat();
+        let mut reads: Vec<_> = targets.iter_mut().flatten().map(|t| (t, Access::FRAGMENT_READ, false)).collect();
+        transition(ctx, cmd, &mut reads);
+        let buffer = self.buffer[0].as_ref().expect("ensured");
+        // Outer only, the resolve reads no inner depths: the buffer stands in for them.
+        let inner = self.buffer[1].as_ref().filter(|_| centred).unwrap_or(buffer);
+        let inputs = [
+            &surface_inputs(frame, light)[..],
+            &[Descriptor::Image(map), Descriptor::Image(buffer), Descriptor::Image(inner)],
+        ]
+        .concat();
         // One frustum for both: equal sizes put the buffer's texels on the map's.
         let key = (params.get(&SMOOTHIE_FALLOFF) as u32, centred, buffer_size == size);
         self.resolve.record(frame, self.visibility, key, visibility, &inputs)
@@ -515,7 +542,7 @@ impl Technique for Smoothie {
         this.smoothie.destroy(ctx);
         this.resolve.destroy(ctx);
         this.vertices.into_iter().for_each(|b| b.destroy(ctx));
-        this.buffer.into_iter().for_each(|t| t.destroy(ctx));
+        this.buffer.into_iter().flatten().for_each(|t| t.destroy(ctx));
         this.casters.destroy(ctx);
         this.gpu.into_iter().for_each(|g| g.destroy(ctx));
     }

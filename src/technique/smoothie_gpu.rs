@@ -178,7 +178,7 @@ impl GpuSilhouettes {
             return Ok((vertices, args));
         }
         let mut params = Vec::with_capacity(casters.len());
-        for o in &casters {
+        for (number, o) in (1..).zip(&casters) {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             let model = o.transform.matrix();
             let (near, caster_far) = match penumbra(centred, &(*view * model), &o.mesh.bounds) {
@@ -189,7 +189,7 @@ impl GpuSilhouettes {
                 model_view: *view * model,
                 size: Vec4::new(scale, near, far, caster_far),
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
-                light: Vec4::new(behind, 0.0, 0.0, 0.0),
+                light: Vec4::new(behind, (number % 2) as f32, 0.0, 0.0),
                 pad: [Vec4::ZERO; 9],
             });
         }

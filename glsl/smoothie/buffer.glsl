@@ -1,0 +1,36 @@
+// What both smoothie-buffer fragment shaders share (smoothie.frag, the paper's outer-only
+// buffer; centred.frag, issue 20's): the vertex stage's outputs, the two surfaces behind a
+// texel (the casters' in the pass-1 map, the ground's exactly, from its plane) and the alpha.
+#ifndef SOFTSHADOW_SMOOTHIE_BUFFER_GLSL
+#define SOFTSHADOW_SMOOTHIE_BUFFER_GLSL
+#include "interface.glsl"
+#include "depth.glsl"
+
+layout(set = 0, binding = 0) uniform Light { LightView light; };
+layout(set = 0, binding = 1) uniform sampler2D shadow_map;
+
+layout(location = 0) noperspective in float in_b;
+layout(location = 1) in vec2 in_shape; // perspective-correct: distance over size (smoothie.vert)
+layout(location = 2) noperspective in vec2 in_probe;
+layout(location = 3) flat in vec2 in_range;
+layout(location = 4) flat in float in_channel;
+
+float map_at(vec2 uv) {
+    float size = light.bias.w;
+    return texelFetch(shadow_map, ivec2(clamp(uv * size, vec2(0.0), vec2(size - 1.0))), 0).r;
+}
+
+// This fragment's linear alpha, 0 on the silhouette, 1 at the smoothie's far side.
+float linear_alpha() {
+    return clamp(length(in_shape), 0.0, 1.0);
+}
+
+// Equation 1 with r, the nearest surface behind this texel (Figure 11 reads it from the map):
+// the casters from the pass-1 map (`caster`), the ground exactly, from its plane. 1 and over
+// where the smoothie is hidden from the light or lies behind every receiver (lit there).
+float remapped_alpha(float alpha, vec2 uv, float caster) {
+    float f = in_b / min(caster, ground_depth(light, uv));
+    return f >= 1.0 ? 1.0 : alpha / (1.0 - f);
+}
+
+#endif
