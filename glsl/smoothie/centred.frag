@@ -29,7 +29,7 @@ layout(location = 0) out vec4 out_smoothie;
 layout(location = 1) out float out_inner_depth;
 
 // α with the channel in its lowest bit, as a 16-bit unsigned normalized value (32-bit floats
-// hold the same code exactly); resolve.frag's inner_texel reads it back.
+// hold the same code exactly); resolve.frag's texels() reads it back.
 float with_channel(float alpha, float channel) {
     return (2.0 * round(alpha * 32767.0) + channel) / 65535.0;
 }
