@@ -1,6 +1,6 @@
 // What both smoothie-buffer fragment shaders share (smoothie.frag, the paper's outer-only
-// buffer; centred.frag, issue 20's): the vertex stage's outputs, the two surfaces behind a
-// texel (the casters' in the pass-1 map, the ground's exactly, from its plane) and the alpha.
+// buffer; centred.frag, issue 20's): the vertex stage's outputs, the casters' depth behind a
+// texel in the pass-1 map, the linear alpha and its remap (Equation 1).
 #ifndef SOFTSHADOW_SMOOTHIE_BUFFER_GLSL
 #define SOFTSHADOW_SMOOTHIE_BUFFER_GLSL
 #include "interface.glsl"
@@ -25,11 +25,9 @@ float linear_alpha() {
     return clamp(length(in_shape), 0.0, 1.0);
 }
 
-// Equation 1 with r, the nearest surface behind this texel (Figure 11 reads it from the map):
-// the casters from the pass-1 map (`caster`), the ground exactly, from its plane. 1 and over
-// where the smoothie is hidden from the light or lies behind every receiver (lit there).
-float remapped_alpha(float alpha, vec2 uv, float caster) {
-    float f = in_b / min(caster, ground_depth(light, uv));
+// Equation 1 for a receiver at depth r; 1 where the smoothie lies at or behind it (lit there).
+float remapped_alpha(float alpha, float r) {
+    float f = in_b / r;
     return f >= 1.0 ? 1.0 : alpha / (1.0 - f);
 }
 

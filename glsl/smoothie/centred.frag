@@ -57,8 +57,7 @@ void main() {
     // caster, and the receivers there are behind both (r: the ground, the one surface known
     // behind it).
     float ground = ground_depth(light, uv);
-    float f = in_b / (in_b < caster ? min(caster, ground) : ground);
-    float a = f < 1.0 ? alpha / (1.0 - f) : 1.0;
+    float a = remapped_alpha(alpha, in_b < caster ? min(caster, ground) : ground);
     if (a >= 1.0) {
         discard; // behind the ground, or lit: what the clear holds
     }

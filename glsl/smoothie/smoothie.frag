@@ -10,7 +10,9 @@ layout(location = 0) out vec2 out_smoothie;
 
 void main() {
     vec2 uv = gl_FragCoord.xy / light.kernel.x;
-    float a = remapped_alpha(linear_alpha(), uv, map_at(uv));
+    // r, the nearest surface behind this texel (Figure 11 reads it from the map): the casters
+    // from the pass-1 map, the ground exactly, from its plane.
+    float a = remapped_alpha(linear_alpha(), min(map_at(uv), ground_depth(light, uv)));
     if (a >= 1.0) {
         discard; // hidden from the light, or lit: what the clear holds
     }
