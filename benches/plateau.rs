@@ -1,6 +1,7 @@
 //! Per-frame CPU cost of the plateau's sides on the largest shipped model (wingnut, 6090
 //! triangles): face facing from the face planes and silhouette edges, then cones, tangents and
-//! sheets, as a frame whose caster or light moved rebuilds them.
+//! sheets, as a frame whose caster or light moved rebuilds them, and the whole frame with the
+//! partial silhouettes.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -8,7 +9,7 @@ use std::path::Path;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::plateau::{
-    Penumbra, PenumbraSize, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
+    Penumbra, PenumbraSize, PlateauLight, ReceiverPlane, caster_sides, plateau_edges, plateau_sides,
 };
 use softshadow::geometry::silhouette::{Caster, EdgeSource};
 use softshadow::scene::Mesh;
@@ -32,6 +33,9 @@ fn plateau(c: &mut Criterion) {
     let edges = plateau_edges(&caster, &wingnut.planes.light_facing(&model, light.position), source);
     c.bench_function("plateau sides (cones, sheets), wingnut", |b| {
         b.iter(|| plateau_sides(&plane, &light, black_box(&caster), &model, &edges, source, 1.0))
+    });
+    c.bench_function("plateau frame (facing, edges, sides, partial silhouettes), wingnut", |b| {
+        b.iter(|| caster_sides(&plane, &light, (black_box(&caster), &wingnut.planes), &model, source, 1.0))
     });
 }
 

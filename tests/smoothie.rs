@@ -173,9 +173,9 @@ fn the_error_against_the_reference_stays_under_its_bounds() {
 #[test]
 fn the_compute_path_draws_the_same_smoothies_as_the_cpu() {
     let mut e = engine();
-    // The default scene (meshes and primitives, several casters) and the plate (a closed
-    // zero-thickness mesh).
-    for name in ["default", "plate"] {
+    // The default scene (meshes and primitives, several casters), the plate (a closed
+    // zero-thickness mesh) and the low light (a face seen nearly edge-on: partial silhouettes).
+    for name in ["default", "plate", "low_light"] {
         let s = suite_scene(name);
         let cpu = render_with(&mut e, &s, "smoothie", &[], 96);
         for _ in 0..3 {

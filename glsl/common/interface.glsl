@@ -63,7 +63,8 @@ struct SilhouetteParams {
                       // y, w: the caster's light-depth range (inner quads)
     uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices, w: 1 for inner quads
     vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE);
-                      // y: the caster's channel in the centred smoothie buffer (0 or 1)
+                      // y: the caster's channel in the centred smoothie buffer (0 or 1);
+                      // z: centred, the light's radius (partial silhouettes), else 0; w: PARTIAL_GAIN
     vec4 pad[9];
 };
 

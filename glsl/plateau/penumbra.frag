@@ -20,6 +20,9 @@ layout(constant_id = 0) const bool CENTRED = false;
 layout(constant_id = 1) const bool OVERLAPS = true;
 // Sheets or wedges (see penumbra.vert for what each interpolates).
 layout(constant_id = 2) const bool SHEETS = false;
+// Centred, the outer halves of partial silhouettes (geometry::plateau::partial_sides): their
+// hard edges lie inside the hard shadow, so they write only where the mask is lit.
+layout(constant_id = 3) const bool PARTIAL = false;
 
 layout(set = 0, binding = 1) uniform sampler2D mask;
 
@@ -109,6 +112,13 @@ void main() {
     }
     out_t = vec2(t, 1.0);
     if (!CENTRED) {
+        return;
+    }
+    if (PARTIAL) {
+        if (caster_at(gl_FragCoord.xy) != 0u) {
+            discard;
+        }
+        out_t = in_channel(in_caster, t);
         return;
     }
     vec2 size = vec2(textureSize(mask, 0));

@@ -56,11 +56,18 @@ void main() {
     // smoothie behind the map's caster still counts: a centred penumbra lets light past that
     // caster, and the receivers there are behind both (r: the ground, the one surface known
     // behind it).
+    // A partial silhouette's (range (b, −1), geometry::smoothie::partial_smoothies) lies over
+    // its own caster's outline: only its outer half counts, where the map is lit, and only for
+    // receivers behind b, past its turned face, which its own terminator already shades.
+    bool partial = in_range.y < 0.0;
+    if (partial && caster < light.kernel.y) {
+        discard;
+    }
     float ground = ground_depth(light, uv);
     float a = remapped_alpha(alpha, in_b < caster ? min(caster, ground) : ground);
     if (a >= 1.0) {
         discard; // behind the ground, or lit: what the clear holds
     }
-    out_smoothie = vec4(depth_code(light, in_b), in_channel == 0.0 ? a : 1.0, in_channel == 0.0 ? 1.0 : a, 1.0);
+    out_smoothie = vec4(depth_code(light, partial ? in_range.x : in_b), in_channel == 0.0 ? a : 1.0, in_channel == 0.0 ? 1.0 : a, 1.0);
     out_inner_depth = 1.0;
 }

@@ -173,10 +173,92 @@ void corner(Silhouette s, int k, uint count, uint other) {
     corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
 }
 
+uint third_of(uvec4 t, uvec2 e) {
+    return t.x != e.x && t.x != e.y ? t.x : (t.y != e.x && t.y != e.y ? t.y : t.z);
+}
+
+// Centred, edge i's smoothie edges as a partial silhouette: a convex edge whose faces face the
+// light's centre alike while some point of the light sphere sees one of them turned (src/
+// geometry/silhouette.rs's partial_silhouettes), drawn where it reaches past what the turned
+// face's far vertex casts (src/geometry/smoothie.rs's partial_smoothies).
+void partial_silhouette(uint i) {
+    uvec4 e = edges[i];
+    float radius = params.light.z;
+    if (radius <= 0.0 || e.w == NO_FACE) {
+        return;
+    }
+    uvec4 f[2] = uvec4[2](triangles[e.z], triangles[e.w]);
+    uint thirds[2] = uint[2](third_of(f[0], e.xy), third_of(f[1], e.xy));
+    // Unit normals out of the mesh (a mirroring transform turns the winding round) and signed
+    // distances from the light's centre, which lies `light.x` behind the view's origin.
+    float side = determinant(mat3(params.model_view)) < 0.0 ? -1.0 : 1.0;
+    vec3 light_at = vec3(0.0, 0.0, -params.light.x);
+    vec3 n[2];
+    float p[2];
+    for (int k = 0; k < 2; k++) {
+        vec3 a = view_position(f[k].x);
+        vec3 normal = side * cross(view_position(f[k].y) - a, view_position(f[k].z) - a);
+        if (dot(normal, normal) == 0.0) {
+            return;
+        }
+        n[k] = normalize(normal);
+        p[k] = dot(n[k], light_at - a);
+    }
+    // Facing the centre alike, across a convex edge (face 1's third vertex behind face 0).
+    vec3 a0 = view_position(f[0].x);
+    if (p[0] * p[1] <= 0.0 || dot(n[0], view_position(thirds[1]) - a0) >= 0.0) {
+        return;
+    }
+    float c = dot(n[0], n[1]), sin2 = 1.0 - c * c;
+    bool line = sin2 > 0.0 && (p[0] * p[0] + p[1] * p[1] - 2.0 * c * p[0] * p[1]) / sin2 < radius * radius;
+    vec3 pa = view_position(e.x), pb = view_position(e.y);
+    if (pa.z <= MIN_DEPTH || pb.z <= MIN_DEPTH) {
+        return;
+    }
+    vec2 ta = pa.xy / pa.z, tb = pb.xy / pb.z;
+    vec2 along = tb - ta;
+    if (dot(along, along) == 0.0) {
+        return;
+    }
+    along = normalize(along);
+    for (int k = 0; k < 2; k++) {
+        int j = 1 - k;
+        if (!(line || abs(p[k]) < radius && (p[j] - c * p[k]) * p[j] > 0.0)) {
+            continue;
+        }
+        // Where the centre sees both faces lit, the one that has not turned faces those points;
+        // where it sees both unlit, the one that has.
+        vec3 pi = view_position(p[0] > 0.0 ? thirds[j] : thirds[k]), pc = view_position(thirds[k]);
+        if (pi.z <= MIN_DEPTH || pc.z <= MIN_DEPTH) {
+            continue;
+        }
+        vec2 perp = vec2(-along.y, along.x);
+        vec2 normal = dot(perp, pi.xy / pi.z - ta) > 0.0 ? -perp : perp;
+        float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z), ka = reach(pa.z), kb = reach(pb.z);
+        float beyond = dot(normal, pc.xy / pc.z) + smoothie_t(pc.z);
+        float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - beyond;
+        if (gain <= params.light.w * max(sa * ka, sb * kb)) {
+            continue;
+        }
+        float behind = max(max(pa.z, pb.z), pc.z);
+        Inner marked = Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(behind, -1.0));
+        float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
+        vec2 da = normal * sa * ka, db = normal * sb * kb;
+        quad(vec2[4](ta, tb, tb + db, ta + da), float[4](pa.z, pb.z, pb.z, pa.z),
+             vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0)), marked, float[4](wa, wb, wb, wa));
+    }
+}
+
 void main() {
     uint i = gl_GlobalInvocationID.x;
+    if (i >= params.counts.x) {
+        return;
+    }
     Silhouette s;
-    if (i >= params.counts.x || !silhouette(i, s)) {
+    if (!silhouette(i, s)) {
+        if (!PAIRING) {
+            partial_silhouette(i);
+        }
         return;
     }
     if (PAIRING) {

@@ -76,7 +76,8 @@ pub struct SilhouetteParams {
     pub size: Vec4,
     pub counts: [u32; 4],
     /// x: how far the light lies behind the view's origin; y: the caster's channel in the
-    /// centred smoothie buffer (`SmoothieVertex::channel`).
+    /// centred smoothie buffer (`SmoothieVertex::channel`); z: centred, the light's radius
+    /// (partial silhouettes), else 0; w: their `PARTIAL_GAIN`.
     pub light: Vec4,
     pub pad: [Vec4; 9],
 }

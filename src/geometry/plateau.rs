@@ -20,7 +20,9 @@ use std::f32::consts::TAU;
 
 use rayon::prelude::*;
 
-use super::silhouette::{Caster, EdgeSource, Facing, penumbra_edges};
+use super::silhouette::{
+    Caster, EdgeSource, FacePlanes, Facing, PARTIAL_GAIN, PartialEdge, partial_silhouettes, penumbra_edges,
+};
 
 /// Fraction of the light's height above which a point casts nothing: its projection from the
 /// light would land behind the light (an anti-shadow). Such vertices get no cones or sheets,
@@ -439,6 +441,9 @@ impl Wedge {
 pub struct PlateauGeometry {
     pub cones: Vec<Wedge>,
     pub sheets: Vec<Sheet>,
+    /// Centred, the outer halves of partial silhouettes ([`partial_sides`]): drawn only where
+    /// the hard shadow is lit.
+    pub partial: Vec<Sheet>,
     /// Plane-space bounds of the shadow: the projected caster (the umbra, even when the
     /// penumbra has no width) and every cone and sheet.
     pub footprint: Option<(Vec2, Vec2)>,
@@ -454,6 +459,7 @@ impl PlateauGeometry {
     pub fn extend(&mut self, other: &PlateauGeometry) {
         self.cones.extend_from_slice(&other.cones);
         self.sheets.extend_from_slice(&other.sheets);
+        self.partial.extend_from_slice(&other.partial);
         if let Some((lo, hi)) = other.footprint {
             self.grow(lo);
             self.grow(hi);
@@ -491,15 +497,14 @@ impl PlateauGeometry {
     }
 
     /// The sheet between the hard edge a→b (t = 0) and the tangent points ta→tb (t = 1), see
-    /// [`Sheet`]. `normal`: the edge's unit normal, `caster`: the caster's number. False when
-    /// the sheet has no width (a hard edge): nothing drawn.
-    fn push_sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> bool {
+    /// [`Sheet`], its corners in the footprint. `normal`: the edge's unit normal, `caster`: the
+    /// caster's number. `None` when the sheet has no width (a hard edge): nothing drawn.
+    fn sheet(&mut self, a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> Option<Sheet> {
         if (ta - a).length_squared().max((tb - b).length_squared()) == 0.0 {
-            return false;
+            return None;
         }
         [a, b, ta, tb].into_iter().for_each(|p| self.grow(p));
-        self.sheets.push(Sheet::new(a, b, ta, tb, normal, caster));
-        true
+        Some(Sheet::new(a, b, ta, tb, normal, caster))
     }
 }
 
@@ -537,6 +542,28 @@ pub fn plateau_edges(caster: &Caster<'_>, facing: &Facing, source: EdgeSource) -
         edges.extend(unlit_boundary_edges(caster, facing));
     }
     edges
+}
+
+/// Everything one caster adds to a frame's plateau, numbered `number`: facing from its face
+/// `planes`, its penumbra edges ([`plateau_edges`]) and their sides ([`plateau_sides`]) and,
+/// centred from silhouettes, its partial silhouettes' ([`partial_sides`]; lit edges are already
+/// drawn whole).
+pub fn caster_sides(
+    plane: &ReceiverPlane,
+    light: &PlateauLight,
+    (caster, planes): (&Caster<'_>, &FacePlanes),
+    model: &Mat4,
+    source: EdgeSource,
+    number: f32,
+) -> PlateauGeometry {
+    let facing = planes.light_facing(model, light.position);
+    let edges = plateau_edges(caster, &facing, source);
+    let mut sides = plateau_sides(plane, light, caster, model, &edges, source, number);
+    if light.penumbra == Penumbra::Centred && source == EdgeSource::Silhouettes {
+        let partial = partial_silhouettes(caster, planes, &facing, model, light.position, light.radius);
+        sides.extend(&partial_sides(plane, light, caster, model, &partial, number));
+    }
+    sides
 }
 
 /// The plateau sides of one caster, numbered `number` (what its primitives carry): a sheet
@@ -648,19 +675,13 @@ fn edge_sheets(
 ) -> [Covers; 2] {
     let mut covers = [[None; 2]; 2];
     let ((Some(ca), Some(cb)), Some(inside)) = (ends, inside) else { return covers };
-    // Outward: away from the light-facing triangle's third vertex, across the edge.
-    let mid = 0.5 * (ca.centre + cb.centre);
-    let along = (cb.centre - ca.centre).normalize_or_zero();
-    let across = (mid - inside) - along * (mid - inside).dot(along);
-    // An edge seen edge-on from its own triangle: either side (the GPU probes both).
-    let normal = across.try_normalize().unwrap_or(along.perp());
+    let normal = outward(&ca, &cb, inside);
     let ab = cb.centre - ca.centre;
     for (k, side) in [normal, -normal].into_iter().enumerate() {
         let cover = if k == 0 || penumbra == Penumbra::Centred {
             let Some((ta, tb)) = outer_tangent(&ca, &cb, side) else { continue };
-            if !out.push_sheet(ca.centre, cb.centre, ta, tb, normal, number) {
-                continue;
-            }
+            let Some(sheet) = out.sheet(ca.centre, cb.centre, ta, tb, normal, number) else { continue };
+            out.sheets.push(sheet);
             (ta - ca.centre, tb - cb.centre)
         } else {
             (side, side)
@@ -669,6 +690,76 @@ fn edge_sheets(
         covers[1][k] = Some((-ab, cover.1));
     }
     covers
+}
+
+/// The unit normal of the hard edge between two cones' apices, away from `inside` (the
+/// projected third vertex of the edge's light-facing triangle); seen edge-on from that triangle,
+/// either side (the GPU probes both).
+fn outward(ca: &Cone, cb: &Cone, inside: Vec2) -> Vec2 {
+    let mid = 0.5 * (ca.centre + cb.centre);
+    let along = (cb.centre - ca.centre).normalize_or_zero();
+    let across = (mid - inside) - along * (mid - inside).dot(along);
+    across.try_normalize().unwrap_or(along.perp())
+}
+
+/// Centred, the outer halves of one caster's partial silhouettes (`edges`, from
+/// [`partial_silhouettes`]), numbered `number`: a sheet on each edge's outer side (away from
+/// its inner vertex), sized by its own cones, where it reaches [`PARTIAL_GAIN`] past what the
+/// silhouette from the centre casts. Their hard edges lie inside the hard shadow, where a face
+/// seen nearly edge-on from the light's centre projects to a sliver beside the silhouette's, so
+/// the GPU draws them only where the hard shadow is lit, and they only darken: there t is the
+/// distance from the edge in its half widths, which near the silhouette exceeds the
+/// silhouette's own and further out, where the wider penumbra of a higher edge still reaches,
+/// is the smaller. Outer only, nothing: the paper's penumbra already spans the whole width
+/// outward. No cones at their ends: the silhouette's cover the shadow's corners.
+///
+/// [`partial_silhouettes`]: super::silhouette::partial_silhouettes
+pub fn partial_sides(
+    plane: &ReceiverPlane,
+    light: &PlateauLight,
+    caster: &Caster<'_>,
+    model: &Mat4,
+    edges: &[PartialEdge],
+    number: f32,
+) -> PlateauGeometry {
+    let mut out = PlateauGeometry::default();
+    if light.penumbra != Penumbra::Centred {
+        return out;
+    }
+    let world = |v: u32| model.transform_point3(caster.positions[v as usize]);
+    // A fine mesh has thousands of partial silhouettes, nearly all of them dropped: each vertex's
+    // cone once, and the tangents only where the cones' reach leaves room for a gain (the
+    // tangent's reach is at most the farther cone's).
+    let mut vertices: Vec<u32> = edges.iter().flat_map(|e| [e.vertices[0], e.vertices[1], e.turned]).collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    let cones: Vec<Option<Cone>> =
+        vertices.par_iter().map(|&v| vertex_cone(plane, light.position, light.radius, light.size, world(v))).collect();
+    let cone = |v: u32| vertices.binary_search(&v).ok().and_then(|i| cones[i]);
+    let sheets: Vec<_> = edges
+        .par_iter()
+        .filter_map(|edge| {
+            let [a, b] = edge.vertices;
+            let (ca, cb, cc) = (cone(a)?, cone(b)?, cone(edge.turned)?);
+            let normal = outward(&ca, &cb, plane.project(light.position, world(edge.inner))?);
+            let beyond = cc.support(normal);
+            let gain = |reach: f32, half: f32| reach - beyond > PARTIAL_GAIN * half;
+            let half = |c: &Cone| c.support(normal) - normal.dot(c.centre);
+            if !gain(ca.support(normal).max(cb.support(normal)), half(&ca).max(half(&cb))) {
+                return None;
+            }
+            let (ta, tb) = outer_tangent(&ca, &cb, normal)?;
+            let reach = normal.dot(ta).max(normal.dot(tb));
+            gain(reach, (ta - ca.centre).dot(normal).max((tb - cb.centre).dot(normal)))
+                .then_some((ca.centre, cb.centre, ta, tb, normal))
+        })
+        .collect();
+    for (a, b, ta, tb, normal) in sheets {
+        if let Some(sheet) = out.sheet(a, b, ta, tb, normal, number) {
+            out.partial.push(sheet);
+        }
+    }
+    out
 }
 
 /// The parts of a vertex's cone that none of the sheets there cover (`covered`: sectors from
@@ -1307,18 +1398,17 @@ mod tests {
                         b.centre + r * outward
                     );
                     assert!((tb - ta).perp_dot(along).abs() < tol, "not parallel to the centre line");
-                    let mut g = PlateauGeometry::default();
-                    g.push_sheet(a.centre, b.centre, ta, tb, Vec2::Y, 1.0);
+                    let sheet = PlateauGeometry::default().sheet(a.centre, b.centre, ta, tb, Vec2::Y, 1.0);
                     if r == 0.0 {
-                        assert!(g.sheets.is_empty(), "point bases: a hard edge, no sheet");
+                        assert!(sheet.is_none(), "point bases: a hard edge, no sheet");
                         continue;
                     }
                     // No twist: a flat quad, t = 0 along the hard edge and 1 along the tangent,
                     // growing with the offset from it.
-                    assert_eq!(g.sheets.len(), 1, "r {r}: one sheet");
+                    let sheet = sheet.unwrap_or_else(|| panic!("r {r}: one sheet"));
                     for (s, t) in [(0.2, 0.1), (0.5, 0.5), (0.9, 0.95)] {
                         let p = a.centre.lerp(b.centre, s) + outward * (t * r);
-                        let (found, _) = g.sheets[0].at(p).expect("on the sheet");
+                        let (found, _) = sheet.at(p).expect("on the sheet");
                         assert!((found - t).abs() < tol / r.max(1e-3) + 1e-4, "r {r}: t {found} at {t} of the width");
                     }
                 }

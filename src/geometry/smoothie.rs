@@ -28,7 +28,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::Aabb;
 use super::chains::{self, MergedEdge, PenumbraEdge};
-use super::silhouette::{Caster, EdgeSource, FacePlanes, penumbra_edges};
+use super::silhouette::{Caster, EdgeSource, FacePlanes, PARTIAL_GAIN, PartialEdge, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 const MIN_DEPTH: f32 = 1e-6;
@@ -51,7 +51,9 @@ pub struct SmoothieVertex {
     pub fy: f32,
     pub nx: f32,
     pub ny: f32,
-    /// Inner quads: the caster's light-depth range; (0, 0) marks the outer smoothies.
+    /// Inner quads: the caster's light-depth range; (0, 0) marks the outer smoothies, (b, −1)
+    /// those of partial silhouettes, b the depth receivers must lie behind
+    /// ([`partial_smoothies`]).
     pub near: f32,
     pub far: f32,
     /// Projective weight 1/t: an edge's t varies along it, so its alpha, distance over t, is
@@ -292,6 +294,57 @@ pub fn merged_smoothies(
     ends.sort_unstable_by_key(|e| e.vertex);
     for group in ends.chunk_by(|x, y| x.vertex == y.vertex) {
         corner(&mut out, group, (size, far), penumbra);
+    }
+    out
+}
+
+/// Centred, the smoothie edges of a caster's partial silhouettes (`edges`, from
+/// [`partial_silhouettes`](super::silhouette::partial_silhouettes)) seen through `view`, as
+/// [`smoothies`] makes a silhouette's, where one reaches [`PARTIAL_GAIN`] of its size past the
+/// smoothie its turned face's far vertex would have. Such an edge lies over its caster's own
+/// outline in the map, where a face seen nearly edge-on from the light's centre is a sliver
+/// beside the silhouette, and for the part of the light behind that face it is the silhouette:
+/// its smoothie, nearer the light than the silhouette's, reaches further out. Marked (near,
+/// far) = (b, −1): the smoothie pass keeps them only where the map is lit, so they only darken
+/// the outer half, and only receivers behind b, the deepest of the edge's and the turned
+/// vertex's depths: the turned face's own surface, which its soft terminator already shades
+/// (the resolve), lies in front (low_light's front face: 759 px too dark by over 0.1 without
+/// it). No corners: the silhouette's cover the outline's turns. The reach compared
+/// is the alpha's on the farthest receiver (t·k, [`reach`]); on any receiver at depth r the
+/// difference of two smoothies' reach is that of their t, R/b − R/r taken from both.
+pub fn partial_smoothies(
+    view: &Mat4,
+    caster: &Caster<'_>,
+    edges: &[PartialEdge],
+    (size, far): (SmoothieSize, f32),
+) -> SmoothieGeometry {
+    let project = |i: u32| {
+        let p = view.transform_point3(caster.positions[i as usize]);
+        (p.z > MIN_DEPTH).then(|| (Vec2::new(p.x, p.y) / p.z, p.z))
+    };
+    let mut out = SmoothieGeometry::default();
+    for edge in edges {
+        let [a, b] = edge.vertices;
+        let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
+        let (Some((inside, _)), Some((pc, zc)), Some(along)) =
+            (project(edge.inner), project(edge.turned), (pb - pa).try_normalize())
+        else {
+            continue;
+        };
+        // Outward: away from the face that faces the light's part they bound.
+        let normal = if along.perp().dot(inside - pa) > 0.0 { -along.perp() } else { along.perp() };
+        let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
+        let extent = |p: Vec2, z: f32| normal.dot(p) + size.at(z);
+        let half = ends.iter().map(|(_, _, k, t)| t * k).fold(0.0, f32::max);
+        if extent(pa, za).max(extent(pb, zb)) - extent(pc, zc) <= PARTIAL_GAIN * half {
+            continue;
+        }
+        let behind = za.max(zb).max(zc);
+        let [a, b] = ends.map(|(p, z, k, t)| {
+            [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)]
+                .map(|v| weighted(SmoothieVertex { near: behind, far: -1.0, ..v }, t))
+        });
+        quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
     }
     out
 }

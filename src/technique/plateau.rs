@@ -74,9 +74,7 @@ use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resol
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
-use crate::geometry::plateau::{
-    Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
-};
+use crate::geometry::plateau::{Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, caster_sides};
 use crate::geometry::silhouette::{Caster, EdgeSource};
 use crate::gpu::{
     Access, Attachment, Blend, Context, DepthState, Descriptor, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
@@ -203,6 +201,17 @@ const MASK_FORMAT: vk::Format = vk::Format::R16_UNORM;
 /// 0.87 against the ray tracer, streaks of capped cones to the horizon).
 const MAX_LIGHT_ANGLE_DEG: f64 = 60.0;
 
+/// The plateau's kinds of side, each drawn with its own pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Side {
+    /// Corner wedges of the vertex cones.
+    Wedge,
+    /// Sheets along the silhouette's edges.
+    Sheet,
+    /// Centred, the outer halves of partial silhouettes' sheets (`partial_sides`).
+    Partial,
+}
+
 /// What a caster's cached sides were built from: rebuilt only when any of it changes.
 #[derive(Clone, Debug, PartialEq)]
 struct SidesKey {
@@ -215,9 +224,9 @@ struct SidesKey {
 
 pub struct Plateau {
     umbra: Pipeline,
-    /// Side pipelines by centring, whether several casters' shadows may overlap, and sheets
-    /// or wedges.
-    penumbrae: Variants<(bool, bool, bool)>,
+    /// Side pipelines by centring, whether several casters' shadows may overlap, and the kind
+    /// of side.
+    penumbrae: Variants<(bool, bool, Side)>,
     /// Resolve pipelines by falloff curve, off-plane mode and centring.
     resolves: Variants<(u32, bool, bool)>,
     /// The V target's format, which the resolves write.
@@ -293,10 +302,9 @@ impl Plateau {
             // then only the edges' vertices placed in the world (issue 18).
             let caster =
                 Caster { positions: &o.mesh.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            let edges = plateau_edges(&caster, &o.mesh.planes.light_facing(&model, light.position), source);
             // The umbra mask's number: the draw's instance (the object's index) plus one.
             let number = (number + 1).min(u16::MAX as usize) as f32;
-            let sides = plateau_sides(plane, &light, &caster, &model, &edges, source, number);
+            let sides = caster_sides(plane, &light, (&caster, &o.mesh.planes), &model, source, number);
             *cached = Some(CasterSides { key, geometry: sides, mesh: o.mesh.clone() });
         }
     }
@@ -377,12 +385,13 @@ impl Technique for Plateau {
 
         // One record per primitive, wedges then sheets, of one size: the vertex shader finds
         // its primitive from gl_VertexIndex (issue 18: 48 bytes a primitive, not a tessellation).
-        let (cones, sheets): (&[u8], &[u8]) = (cast_slice(&geometry.cones), cast_slice(&geometry.sheets));
-        if !cones.is_empty() || !sheets.is_empty() {
+        let records: [&[u8]; 3] =
+            [cast_slice(&geometry.cones), cast_slice(&geometry.sheets), cast_slice(&geometry.partial)];
+        let bytes = records.iter().map(|r| r.len() as u64).sum();
+        if bytes > 0 {
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            let bytes = (cones.len() + sheets.len()) as u64;
             let buffer = PerFrame::ensure(ctx, &mut self.primitives, "plateau sides", bytes, usage)?;
-            buffer.write(frame.slot, &[cones, sheets].concat());
+            buffer.write(frame.slot, &records.concat());
         }
         let cmd = frame.cmd;
 
@@ -408,19 +417,15 @@ impl Technique for Plateau {
         frame.timer.end(ctx, cmd);
 
         let overlaps = self.sides.iter().flatten().count() > 1;
-        let cones = geometry.cones.len() as u32;
-        // Per primitive, a wedge's three triangles or a sheet's two (see penumbra.vert).
-        let ranges = [("cones", false, 0, 9 * cones), ("sheets", true, 6 * cones, 6 * geometry.sheets.len() as u32)];
-        for (i, (name, sheet, first, count)) in ranges.into_iter().enumerate() {
-            let penumbra = self.penumbrae.get((centred, overlaps, sheet), |&(centred, overlaps, sheet)| {
-                let constants = [("CENTRED", centred as u32), ("OVERLAPS", overlaps as u32), ("SHEETS", sheet as u32)];
-                let (vert, frag) = (&shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG);
-                let desc = PipelineDesc::new("penumbra", vert, frag)
-                    .colors(&[PLATEAU_FORMAT])
-                    .blend(Blend::Min)
-                    .constants(&constants);
-                Pipeline::new(ctx, &desc)
-            })?;
+        let (cones, sheets) = (geometry.cones.len() as u32, geometry.sheets.len() as u32);
+        // Per primitive, a wedge's three triangles or a sheet's two (see penumbra.vert); partial
+        // silhouettes' sheets in the sheets' pass, after them.
+        let sheet_draws = [
+            (Side::Sheet, 6 * cones, 6 * sheets),
+            (Side::Partial, 6 * (cones + sheets), 6 * geometry.partial.len() as u32),
+        ];
+        let passes = [("cones", &[(Side::Wedge, 0, 9 * cones)][..]), ("sheets", &sheet_draws[..])];
+        for (i, (name, draws)) in passes.into_iter().enumerate() {
             frame.timer.begin(ctx, cmd, name);
             // The sides read the mask; the cones' pass clears t to 1 (lit), the sheets' carries
             // on. Blended by min, channel by channel: the darkest primitive wins (§2).
@@ -431,7 +436,22 @@ impl Technique for Plateau {
                 false => Attachment { target: texture, clear: None },
             };
             let pass = RenderPass::begin(ctx, cmd, &[color], None);
-            if let Some(primitives) = self.primitives.as_ref().filter(|_| count > 0) {
+            for &(side, first, count) in draws.iter().filter(|d| d.2 > 0) {
+                let Some(primitives) = self.primitives.as_ref() else { break };
+                let penumbra = self.penumbrae.get((centred, overlaps, side), |&(centred, overlaps, side)| {
+                    let constants = [
+                        ("CENTRED", centred as u32),
+                        ("OVERLAPS", overlaps as u32),
+                        ("SHEETS", (side != Side::Wedge) as u32),
+                        ("PARTIAL", (side == Side::Partial) as u32),
+                    ];
+                    let (vert, frag) = (&shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG);
+                    let desc = PipelineDesc::new("penumbra", vert, frag)
+                        .colors(&[PLATEAU_FORMAT])
+                        .blend(Blend::Min)
+                        .constants(&constants);
+                    Pipeline::new(ctx, &desc)
+                })?;
                 let inputs = [
                     Descriptor::Buffer(view_range),
                     Descriptor::Image(mask),

@@ -73,10 +73,10 @@ use super::{Technique, clear_visibility, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::Aabb;
-use crate::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
+use crate::geometry::silhouette::{Caster, EdgeSource, PartialEdge, partial_silhouettes, penumbra_edges};
 use crate::geometry::smoothie::{
     Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette, merged_smoothies,
-    smoothies,
+    partial_smoothies, smoothies,
 };
 use crate::gpu::{
     Access, Attachment, Blend, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
@@ -316,12 +316,16 @@ struct SilhouetteKey {
     mesh: crate::scene::MeshId,
     model: Mat4,
     light: Vec3,
+    /// The light's radius, centred; 0 (no partial silhouettes) outer only.
+    partial_radius: f32,
 }
 
-/// A caster's silhouette edges (object-space vertex numbers) and what they were found from.
+/// A caster's silhouette edges and partial silhouettes (object-space vertex numbers), and
+/// what they were found from.
 struct CasterSilhouette {
     key: SilhouetteKey,
     edges: Vec<([u32; 2], u32)>,
+    partial: Vec<PartialEdge>,
 }
 
 pub struct Smoothie {
@@ -385,7 +389,8 @@ impl Smoothie {
             number += 1;
             let o = &Object { mesh: mesh.clone(), ..o.clone() };
             let model = o.transform.matrix();
-            let key = SilhouetteKey { mesh: o.mesh.id(), model, light };
+            let partial_radius = if centred { frame.scene.light.radius } else { 0.0 };
+            let key = SilhouetteKey { mesh: o.mesh.id(), model, light, partial_radius };
             // In object space: the face planes built with the mesh against the light taken
             // there, then the silhouette's own vertices through view · model, so a moved caster
             // costs no transform of its whole mesh.
@@ -394,17 +399,20 @@ impl Smoothie {
             if cached.as_ref().is_none_or(|c| c.key != key) {
                 let facing = o.mesh.planes.light_facing(&model, light);
                 let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
-                *cached = Some(CasterSilhouette { key, edges });
+                let planes = &o.mesh.planes;
+                let partial = partial_silhouettes(&caster, planes, &facing, &model, light, partial_radius);
+                *cached = Some(CasterSilhouette { key, edges, partial });
             }
             let c = cached.as_ref().expect("set above");
             let view = *view * model;
             let penumbra = penumbra(centred, &view, &o.mesh.bounds);
-            let geometry = if tolerance > 0.0 {
+            let mut geometry = if tolerance > 0.0 {
                 let merged = merged_silhouette(&view, &caster, &c.edges, (size, far), tolerance);
                 merged_smoothies(&view, &caster, &merged, (size, far), penumbra)
             } else {
                 smoothies(&view, &caster, &c.edges, (size, far), penumbra)
             };
+            geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, far)));
             out.extend(&geometry.in_channel(number));
         }
         out
@@ -469,7 +477,9 @@ impl Technique for Smoothie {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }
             let gpu = self.gpu.as_mut().expect("made above");
-            let (vertices, args) = gpu.record(frame, &cast, &frustum.view, (smoothie_size, frustum.far), centred)?;
+            let radius = frame.scene.light.radius;
+            let (vertices, args) =
+                gpu.record(frame, &cast, &frustum.view, (smoothie_size, frustum.far), (centred, radius))?;
             Smoothies::Indirect { vertices, args }
         } else {
             // The merge bound in tangent units: texels of the smoothie buffer over the window.

@@ -17,6 +17,7 @@ use super::smoothie::penumbra;
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
+use crate::geometry::silhouette::PARTIAL_GAIN;
 use crate::geometry::smoothie::{Penumbra, SmoothieSize};
 use crate::gpu::{
     Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
@@ -95,6 +96,8 @@ struct OutputKey {
     casters: Vec<(MeshId, Mat4)>,
     size: [f32; 4],
     centred: bool,
+    /// The light's radius, centred (partial silhouettes); 0 outer only.
+    partial_radius: f32,
     capacity: u64,
 }
 
@@ -124,7 +127,7 @@ impl GpuSilhouettes {
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
         (size, far): (SmoothieSize, f32),
-        centred: bool,
+        (centred, light_radius): (bool, f32),
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<Object> = (frame.scene.objects.iter().zip(cast))
@@ -135,8 +138,8 @@ impl GpuSilhouettes {
             .iter()
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
-        // Six vertices per quad: one per edge (two with the inner quads), at most three per
-        // corner.
+        // Six vertices per quad: one per edge (two with the inner quads, or a partial
+        // silhouette's two), at most three per corner.
         let quads_per_edge = 1 + centred as usize;
         let capacity: u64 = casters
             .iter()
@@ -159,6 +162,7 @@ impl GpuSilhouettes {
             vk::BufferUsageFlags::UNIFORM_BUFFER,
         )?;
 
+        let partial_radius = if centred { light_radius } else { 0.0 };
         let (scale, behind, physical) = match size {
             SmoothieSize::Physical { light_radius, scale, behind } => (light_radius * scale, behind, true),
             SmoothieSize::Fixed(t) => (t, 0.0, false),
@@ -171,6 +175,7 @@ impl GpuSilhouettes {
             casters: casters.iter().map(|o| (o.mesh.id(), *view * o.transform.matrix())).collect(),
             size: [scale, f32::from(u8::from(physical)), far, behind],
             centred,
+            partial_radius,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
         // A lost frame ran neither its uploads nor its dispatches.
@@ -189,7 +194,7 @@ impl GpuSilhouettes {
                 model_view: *view * model,
                 size: Vec4::new(scale, near, far, caster_far),
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
-                light: Vec4::new(behind, (number % 2) as f32, 0.0, 0.0),
+                light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
                 pad: [Vec4::ZERO; 9],
             });
         }
