@@ -13,6 +13,8 @@
 //! which gives the distance its sign. Each vertex carries the silhouette point it measures from
 //! (its foot) and the edge's normal, so the GPU can drop the distances to silhouettes that do
 //! not lie on the hard shadow's boundary (interior folds, edges under another caster's shadow).
+//! [`partial_sides`] adds the outer halves of edges that are the silhouette for part of the
+//! light only ([`caster_sides`] puts a caster's together).
 
 use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
 

@@ -23,6 +23,8 @@
 //! Inside a convex corner the two edges' inner quads overlap (minimum blending keeps the
 //! shallower, lighter alpha); inside a concave one they leave a gap, which the mirror image of
 //! the outer wedge fills (see [`corner`]).
+//! [`partial_smoothies`] adds the smoothie edges of edges that are the silhouette for part of
+//! the light only.
 
 use glam::{Mat4, Vec2, Vec3};
 

@@ -31,6 +31,15 @@
 //! shadows overlap, the lowest caster's number, so no inner penumbra lightens what another
 //! caster blocks.
 //!
+//! One silhouette, from the light's centre, is not always enough. A face seen within the
+//! light's angular radius of edge-on turns its back to part of the light, and from there the
+//! silhouette is its other edge, often higher and with the wider penumbra (`low_light`'s box:
+//! the truth's outer half 4.5 px against the centred sheets' 3.2, a lit band too light by 0.13).
+//! Centred, such partial silhouettes (`geometry::silhouette::partial_silhouettes`) add the outer
+//! half of their own sheet wherever it reaches past what the silhouette casts, drawn only where
+//! the mask is lit (`PARTIAL`); a fine mesh's, a ring beside its silhouette, almost all reach
+//! no further and are dropped on the CPU.
+//!
 //! Cost (issue 18). A cone is drawn only where no sheet covers it, the wedge of a corner
 //! (`cones = 0`: Haines' whole cones, measured against): on fine meshes, whose edges are far
 //! shorter than the penumbra, whole cones drew each texel several times over (the koala's

@@ -41,6 +41,13 @@
 //! another blocker in the channel the inner half is not in. Together they took the leaking
 //! pixels on overlap and two_boxes from 90 and 51 to 0 (512², against the reference).
 //!
+//! Partial silhouettes, centred, as the plateau's: a face within the light's angular radius of
+//! edge-on hands the silhouette to its other edge for part of the light, whose smoothie reaches
+//! further out (`low_light`: 137 leaking pixels, 27 with them). Their smoothie edges
+//! (`geometry::smoothie::partial_smoothies`, and the compute path's) lie over their caster's
+//! outline in the map; the smoothie pass keeps them where the map is lit, and the resolve lets
+//! them darken only receivers behind the turned face.
+//!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard
 //! edge the penumbra straddles is the silhouettes' own edge. Only the camera draws the full mesh.
