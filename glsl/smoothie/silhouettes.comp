@@ -173,6 +173,18 @@ void corner(Silhouette s, int k, uint count, uint other) {
     corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
 }
 
+// The smoothie edge of the hard edge ta–tb (depths za, zb) out along `out_dir`, alpha 0 on the
+// edge and the reach k at t·k out, with projective weights 1/t (src/geometry/smoothie.rs's
+// SmoothieVertex::w).
+void edge_quad(vec2 ta, vec2 tb, float za, float zb, vec2 out_dir, Inner inner) {
+    float ka = reach(za), kb = reach(zb);
+    float sa = smoothie_t(za), sb = smoothie_t(zb);
+    vec2 da = out_dir * sa * ka, db = out_dir * sb * kb;
+    float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
+    quad(vec2[4](ta, tb, tb + db, ta + da), float[4](za, zb, zb, za),
+         vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0)), inner, float[4](wa, wb, wb, wa));
+}
+
 uint third_of(uvec4 t, uvec2 e) {
     return t.x != e.x && t.x != e.y ? t.x : (t.y != e.x && t.y != e.y ? t.y : t.z);
 }
@@ -234,18 +246,14 @@ void partial_silhouette(uint i) {
         }
         vec2 perp = vec2(-along.y, along.x);
         vec2 normal = dot(perp, pi.xy / pi.z - ta) > 0.0 ? -perp : perp;
-        float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z), ka = reach(pa.z), kb = reach(pb.z);
+        float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z);
         float beyond = dot(normal, pc.xy / pc.z) + smoothie_t(pc.z);
         float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - beyond;
-        if (gain <= params.light.w * max(sa * ka, sb * kb)) {
+        if (gain <= params.light.w * max(sa * reach(pa.z), sb * reach(pb.z))) {
             continue;
         }
         float behind = max(max(pa.z, pb.z), pc.z);
-        Inner marked = Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(behind, -1.0));
-        float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
-        vec2 da = normal * sa * ka, db = normal * sb * kb;
-        quad(vec2[4](ta, tb, tb + db, ta + da), float[4](pa.z, pb.z, pb.z, pa.z),
-             vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0)), marked, float[4](wa, wb, wb, wa));
+        edge_quad(ta, tb, pa.z, pb.z, normal, Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(behind, -1.0)));
     }
 }
 
@@ -279,18 +287,10 @@ void main() {
     if (!s.sided) {
         return;
     }
-    float za = s.z[0], zb = s.z[1];
-    vec2 ta = s.t[0], tb = s.t[1], normal = s.normal;
-    float ka = reach(za), kb = reach(zb);
-    float sa = smoothie_t(za), sb = smoothie_t(zb);
-    vec2 da = normal * sa * ka, db = normal * sb * kb;
-    float b[4] = float[4](za, zb, zb, za);
-    vec2 sh[4] = vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0));
-    float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
-    float w[4] = float[4](wa, wb, wb, wa);
-    quad(vec2[4](ta, tb, tb + db, ta + da), b, sh, OUTER, w);
+    vec2 ta = s.t[0], tb = s.t[1];
+    edge_quad(ta, tb, s.z[0], s.z[1], s.normal, OUTER);
     if (params.counts.w != 0u) {
         // The inner quad, mirrored over the blocker (issue 20).
-        quad(vec2[4](ta, tb, tb - db, ta - da), b, sh, Inner(vec2[4](ta, tb, tb, ta), normal, params.size.yw), w);
+        edge_quad(ta, tb, s.z[0], s.z[1], -s.normal, Inner(vec2[4](ta, tb, tb, ta), s.normal, params.size.yw));
     }
 }
