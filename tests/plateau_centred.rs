@@ -7,7 +7,8 @@
 mod common;
 
 use common::{
-    engine, error_minimising_scale, finish, reference, render_with, scene, suite_scene, terminator_error, top_down,
+    HIDDEN_IN_THE_SPHERE, engine, error_minimising_scale, finish, largest_difference, reference, render_with, scene,
+    sphere_with, suite_scene, terminator_error, top_down,
 };
 use softshadow::Capture;
 use softshadow::measure::Metrics;
@@ -296,4 +297,25 @@ fn abutting_hard_shadows_leave_no_seam_in_the_umbra() {
     assert!(umbra.len() > 4000, "the reference's umbra on the ground: {} px", umbra.len());
     let worst = umbra.iter().map(|&i| v.visibility[i]).max().unwrap() as f32 / 65535.0;
     assert!(worst <= 0.05, "V up to {worst} on the ground inside the reference's umbra");
+}
+
+/// One caster's plateau texture has one channel (penumbra.frag writes it in r whatever the
+/// caster's number), several casters' two: the sphere alone, after an object that casts nothing
+/// (the sphere caster number 2, whose channel would be g), and with a second caster hidden
+/// inside it give the same V, centred and outer only.
+#[test]
+fn one_caster_s_texture_reads_as_the_channels_do() {
+    let far_away =
+        "[[object]]\nshape = \"box\"\ncasts = false\nsize = [0.1, 0.1, 0.1]\nposition = [40.0, 0.05, 40.0]\n";
+    let scenes = [sphere_with("", ""), sphere_with(far_away, ""), sphere_with("", HIDDEN_IN_THE_SPHERE)];
+    let mut e = engine();
+    for sets in [&[][..], OUTER] {
+        let [a, b, c] = scenes.each_ref().map(|s| render_with(&mut e, s, "plateau", sets, 128));
+        let penumbra = a.visibility.iter().filter(|x| (0.02..0.98).contains(&(**x as f32 / 65535.0))).count();
+        let (second, channels) = (largest_difference(&a, &b), largest_difference(&a, &c));
+        eprintln!("{sets:?}: {penumbra} penumbra px; caster number 2: {second}, two channels: {channels}");
+        assert!(penumbra > 100, "a penumbra to compare: {penumbra} px");
+        assert!(second <= 0.002 && channels <= 0.002, "V differs: {second} (number 2), {channels} (channels)");
+    }
+    finish(e);
 }

@@ -7,7 +7,10 @@
 
 mod common;
 
-use common::{crossing, engine, error_minimising_scale, finish, reference, render_with, suite_scene, terminator_error};
+use common::{
+    HIDDEN_IN_THE_SPHERE, crossing, engine, error_minimising_scale, finish, largest_difference, reference, render_with,
+    sphere_with, suite_scene, terminator_error,
+};
 use softshadow::Capture;
 use softshadow::measure::Metrics;
 use softshadow::scene::Scene;
@@ -105,7 +108,7 @@ fn overlapping_plates_leak_no_more_than_outer_only() {
     // kept one of them while the truth darkens by both (8 px here in one channel), and a
     // smoothie behind the map's caster was dropped where that caster's inner penumbra lets light
     // through (3 px without it). An inner half over another caster's shadow is another
-    // matter: without the acceptance test (centred.frag) this scene leaks on about 100 px.
+    // matter: without the acceptance test (centred.glsl) this scene leaks on about 100 px.
     let rate = |c: &Capture| Metrics::between(c, &truth).unwrap().leak_rate;
     eprintln!("leak rate: centred {:.5}, outer only {:.5}", rate(&centred), rate(&outer));
     assert!(leaks <= outer_leaks, "centred {leaks} px lighter than the truth + 0.05, outer only {outer_leaks}");
@@ -153,6 +156,24 @@ fn brightest_in_umbra(c: &Capture, truth: &Capture) -> f32 {
         .filter(|&(x, y)| (0..9).all(|k| umbra(x + k % 3 - 1, y + k / 3 - 1)))
         .map(|(x, y)| c.visibility_at(x, y))
         .fold(0.0, f32::max)
+}
+
+/// One caster's buffer (one target, glsl/smoothie/centred_one.frag) reads as the buffer of
+/// several casters (two channels and a target of inner depths, centred.frag) with that caster
+/// alone: a second caster hidden inside the sphere, which changes neither the map nor any
+/// shadow, switches the technique to the channels and leaves V as it was.
+#[test]
+fn one_caster_s_buffer_reads_as_the_channels_do() {
+    let [one, two] = [sphere_with("", ""), sphere_with("", HIDDEN_IN_THE_SPHERE)];
+    assert_eq!(two.objects.len(), 2);
+    let mut e = engine();
+    let [a, b] = [&one, &two].map(|s| render_with(&mut e, s, "smoothie", CENTRED, 128));
+    let penumbra = a.visibility.iter().filter(|x| (0.02..0.98).contains(&(**x as f32 / 65535.0))).count();
+    let worst = largest_difference(&a, &b);
+    eprintln!("{penumbra} penumbra px, largest difference {worst}");
+    assert!(penumbra > 100, "a penumbra to compare: {penumbra} px");
+    assert!(worst <= 0.002, "V differs by {worst} between the two buffers");
+    finish(e);
 }
 
 #[test]

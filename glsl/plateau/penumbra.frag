@@ -1,6 +1,6 @@
 #version 460
 // The plateau's sides write t, blended by min (the darkest wins, Haines §2), into channel r
-// (outer only; g stays 1). Centred (issue 20), t is the distance to the hard shadow's boundary
+// (outer only, or one caster: the texture's only channel). Centred (issue 20), t is the distance to the hard shadow's boundary
 // in half widths on both of its sides, so only silhouettes on that boundary may write it: the
 // mask must be lit a couple of texels off the foot, across the edge (either way: an edge seen edge-on has no
 // reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
@@ -93,9 +93,10 @@ uint caster_at(vec2 texel) {
     return uint(round(texelFetch(mask, i, 0).r * 65535.0));
 }
 
-// t in the channel of caster number `caster` (r odd, g even), the other left lit.
+// t in the channel of caster number `caster` (r odd, g even), the other left lit; one caster's
+// in r, the texture's only channel.
 vec2 in_channel(uint caster, float t) {
-    return caster % 2u == 1u ? vec2(t, 1.0) : vec2(1.0, t);
+    return !OVERLAPS || caster % 2u == 1u ? vec2(t, 1.0) : vec2(1.0, t);
 }
 
 void main() {

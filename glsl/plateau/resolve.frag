@@ -15,6 +15,8 @@
 layout(constant_id = 0) const bool OFF_PLANE_MAP = false;
 // The `penumbra` knob: centred on the hard edge, or outer only.
 layout(constant_id = 1) const bool CENTRED = false;
+// Centred, several casters: the texture's second channel (penumbra.frag). Else it has one.
+layout(constant_id = 2) const bool CHANNELS = true;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
@@ -27,7 +29,7 @@ layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
 // One texel's curve parameters. Outer only: t, 0 inside the mask. Centred, per channel (odd
-// and even casters, see penumbra.frag): t, or −t in the channel of the caster whose hard shadow
+// and even casters, see penumbra.frag; one caster's in r alone): t, or −t in the channel of the caster whose hard shadow
 // covers the texel; and where either channel is umbra (s ≤ −1, V = 0 whatever the other says),
 // both are. Where two casters' hard shadows abut, the channels swap roles between texels (one
 // caster's umbra beside the other's outer band), and interpolated apart they drew a lit seam
@@ -37,7 +39,7 @@ vec2 texel_s(vec2 t, uint caster) {
     if (!CENTRED) {
         return vec2(caster > 0u ? 0.0 : t.r, 1.0);
     }
-    bvec2 own = bvec2(caster % 2u == 1u, caster > 0u && caster % 2u == 0u);
+    bvec2 own = CHANNELS ? bvec2(caster % 2u == 1u, caster > 0u && caster % 2u == 0u) : bvec2(caster > 0u, false);
     vec2 s = mix(t, -t, own);
     return min(s.x, s.y) <= -1.0 ? vec2(-1.0) : s;
 }
@@ -58,7 +60,7 @@ vec2 plateau_s(vec2 tc) {
     vec2 f = fract(pos);
     vec2 corner = (floor(pos) + 1.0) / size;
     vec4 r = textureGather(plateau_texture, corner, 0);
-    vec4 g = CENTRED ? textureGather(plateau_texture, corner, 1) : vec4(1.0);
+    vec4 g = CENTRED && CHANNELS ? textureGather(plateau_texture, corner, 1) : vec4(1.0);
     uvec4 casters = uvec4(round(textureGather(umbra_mask, corner, 0) * 65535.0));
     vec2 s[4];
     for (int k = 0; k < 4; k++) {

@@ -1,5 +1,5 @@
-// What both smoothie-buffer fragment shaders share (smoothie.frag, the paper's outer-only
-// buffer; centred.frag, issue 20's): the vertex stage's outputs, the casters' depth behind a
+// What the smoothie-buffer fragment shaders share (smoothie.frag, the paper's outer-only
+// buffer; centred.glsl's, issue 20's): the vertex stage's outputs, the casters' depth behind a
 // texel in the pass-1 map, the linear alpha and its remap (Equation 1).
 #ifndef SOFTSHADOW_SMOOTHIE_BUFFER_GLSL
 #define SOFTSHADOW_SMOOTHIE_BUFFER_GLSL

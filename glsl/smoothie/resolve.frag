@@ -4,7 +4,8 @@
 // tests at the four nearest texels, filtered bilinearly, then the falloff curve. CENTRED
 // (issue 20): the penumbra straddles the hard edge, t = ½ + ½α' on the lit side and ½ − ½α'
 // over the blocker, each smoothie texel classified by the map at its own centre, in two
-// channels (odd and even casters, centred.frag) whose visibilities multiply.
+// channels (odd and even casters, centred.frag) whose visibilities multiply; one caster's
+// buffer (centred_one.frag) reads as the even channel alone.
 #include "interface.glsl"
 #include "camera.glsl"
 #include "shadow.glsl"
@@ -19,6 +20,8 @@ layout(constant_id = 1) const bool SAME_GRID = true;
 // alone. llvmpipe runs every branch of a fragment shader, so without the mask every pixel paid
 // for the smoothie fetches; a GPU skips them too, but only in whole warps.
 layout(constant_id = 2) const bool MASK = false;
+// Centred: the buffer of several casters (centred.frag), or of one (centred_one.frag).
+layout(constant_id = 3) const bool CHANNELS = true;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Light { LightView light; };
@@ -26,9 +29,9 @@ layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D shadow_map;
 // Outer only: b, α' (smoothie.frag). Centred: b, α' of even and of odd casters, inner α with its
-// channel (centred.frag).
+// channel (centred.frag); one caster: b, α', the inner quads' 1 − b and α (centred_one.frag).
 layout(set = 0, binding = 5) uniform sampler2D smoothies;
-// Centred: 1 − b of the inner quads (depth.glsl codes); outer only, unread.
+// Centred, several casters: 1 − b of the inner quads (depth.glsl codes); else unread.
 layout(set = 0, binding = 6) uniform sampler2D inner_depths;
 
 layout(location = 0) in vec2 in_uv;
@@ -63,19 +66,24 @@ Texels texels(vec2 uv, float depth) {
     vec2 pos = smoothie_pos(uv);
     t.base = ivec2(pos);
     t.f = fract(pos);
-    if (CENTRED) {
+    if (CENTRED && CHANNELS) {
         t.inner_b = 1.0 - textureGather(inner_depths, (vec2(t.base) + 1.0) / light.kernel.x, 0);
     }
     for (int k = 0; k < 4; k++) {
         vec4 texel = texelFetch(smoothies, t.base + GATHER_ORDER[k], 0);
         t.b[k] = texel.x;
         t.outer[k] = texel.y;
-        if (CENTRED) {
+        if (CENTRED && CHANNELS) {
             t.outer_odd[k] = texel.z;
             // The channel in the alpha's lowest bit (centred.frag's with_channel).
             uint coded = uint(round(texel.w * 65535.0));
             t.inner[k] = float(coded >> 1u) / 32767.0;
             t.inner_odd[k] = float(coded & 1u);
+        } else if (CENTRED) {
+            t.outer_odd[k] = 1.0;
+            t.inner[k] = texel.w;
+            t.inner_odd[k] = 0.0;
+            t.inner_b[k] = 1.0 - texel.z;
         }
     }
     t.behind = vec4(greaterThan(vec4(code), t.b));
@@ -150,11 +158,12 @@ bool near_smoothie(vec2 uv, float umbra) {
     vec2 corner = (floor(smoothie_pos(uv)) + 1.0) / light.kernel.x;
     bool edge = umbra > 0.0 && umbra < 1.0;
     if (CENTRED) {
-        // An outer smoothie is written only with α' < 1 (centred.frag), so its depth tells;
-        // an inner alpha of 1 reads 65534 or 65535 (its channel bit).
+        // An outer smoothie is written only with α' < 1 (centred.glsl), so its depth tells;
+        // an inner alpha of 1 reads 65534 or 65535 with its channel bit, else 65535.
         vec4 b = textureGather(smoothies, corner, 0);
         vec4 inner = textureGather(smoothies, corner, 3);
-        return edge || any(lessThan(b, vec4(1.0))) || any(lessThan(inner, vec4(65533.5 / 65535.0)));
+        float umbra_alpha = CHANNELS ? 65533.5 / 65535.0 : 1.0;
+        return edge || any(lessThan(b, vec4(1.0))) || any(lessThan(inner, vec4(umbra_alpha)));
     }
     if (umbra == 0.0) {
         return false; // outer only: the map's umbra stays umbra

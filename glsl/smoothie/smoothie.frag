@@ -3,7 +3,7 @@
 // target remark, §4, packed): depth b (its code, depth.glsl) and remapped alpha α' (Equation
 // 1) of the smoothies, composited with minimum blending, so the nearest smoothie depth and the
 // minimum alpha (Parker's thresholding, §3.1) come out in any drawing order. Both channels
-// clear to 1. centred.frag is issue 20's buffer.
+// clear to 1. centred.frag and centred_one.frag are issue 20's buffers.
 #include "buffer.glsl"
 
 layout(location = 0) out vec2 out_smoothie;

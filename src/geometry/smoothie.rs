@@ -18,7 +18,7 @@
 //! the truth's does: the true penumbra of a straight edge spans (R/b)(1 − b/r) on *each* side
 //! of the hard edge in the light's tangent plane (similar triangles through the edge from both
 //! rims of the light). Inner vertices carry what the smoothie pass needs to accept them only
-//! where the edge bounds this caster's own hard shadow (`glsl/smoothie/centred.frag`): the
+//! where the edge bounds this caster's own hard shadow (`glsl/smoothie/centred.glsl`): the
 //! point of the edge they belong to, its outward normal and the caster's light-depth range.
 //! Inside a convex corner the two edges' inner quads overlap (minimum blending keeps the
 //! shallower, lighter alpha); inside a concave one they leave a gap, which the mirror image of

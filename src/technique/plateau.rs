@@ -198,8 +198,12 @@ const OFF_PLANE: Knob = Knob {
 };
 
 /// The plateau texture: t of the caster whose hard shadow covers the texel (or of every caster,
-/// where none does), and centred, t of other casters' outer penumbrae over that hard shadow.
+/// where none does), and centred with several casters, t of other casters' outer penumbrae over
+/// that hard shadow (glsl/plateau/penumbra.frag's two channels).
 const PLATEAU_FORMAT: vk::Format = vk::Format::R16G16_UNORM;
+/// The plateau texture with nothing for a second channel to hold: outer only, or one caster.
+/// Half the bytes for every pass that writes or reads it to clear, blend and gather.
+const PLATEAU_FORMAT_ONE: vk::Format = vk::Format::R16_UNORM;
 /// The umbra mask: each texel the number of the caster whose hard shadow covers it (0: none).
 const MASK_FORMAT: vk::Format = vk::Format::R16_UNORM;
 
@@ -236,8 +240,12 @@ pub struct Plateau {
     /// Side pipelines by centring, whether several casters' shadows may overlap, and the kind
     /// of side.
     penumbrae: Variants<(bool, bool, Side)>,
-    /// Resolve pipelines by falloff curve, off-plane mode and centring.
-    resolves: Variants<(u32, bool, bool)>,
+    /// Resolve pipelines by falloff curve, off-plane mode, centring and whether the texture
+    /// has two channels.
+    resolves: Variants<(u32, bool, bool, bool)>,
+    /// The plateau texture's format, with one channel and with two: where the device cannot
+    /// blend into one 16-bit channel (Vulkan does not require it), two.
+    formats: [vk::Format; 2],
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     view: PerFrame,
@@ -279,6 +287,10 @@ impl Plateau {
             umbra: umbra.keep(),
             penumbrae: Variants::default(),
             resolves: Variants::default(),
+            formats: [
+                if ctx.renders_blended(PLATEAU_FORMAT_ONE) { PLATEAU_FORMAT_ONE } else { PLATEAU_FORMAT },
+                PLATEAU_FORMAT,
+            ],
             visibility,
             view,
             primitives: None,
@@ -367,7 +379,11 @@ impl Technique for Plateau {
         let mut geometry = PlateauGeometry::default();
         self.sides.iter().flatten().for_each(|c| geometry.extend(&c.geometry));
         let tex_size = params.get(&TEXTURE_SIZE) as u32;
-        ensure(ctx, &mut self.texture, TargetDesc::color("plateau texture", PLATEAU_FORMAT, tex_size, tex_size))?;
+        let overlaps = self.sides.iter().flatten().count() > 1;
+        // Centred, a second caster's outer penumbra over one's hard shadow takes the second channel.
+        let channels = centred && overlaps;
+        let texture_format = self.formats[usize::from(channels)];
+        ensure(ctx, &mut self.texture, TargetDesc::color("plateau texture", texture_format, tex_size, tex_size))?;
         ensure(ctx, &mut self.mask, TargetDesc::color("plateau mask", MASK_FORMAT, tex_size, tex_size))?;
         ensure(ctx, &mut self.depth, TargetDesc::depth("plateau depth", tex_size, tex_size))?;
         let Some(window) = self.window(&plane, &geometry, frame) else {
@@ -425,7 +441,6 @@ impl Technique for Plateau {
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
 
-        let overlaps = self.sides.iter().flatten().count() > 1;
         let (cones, sheets) = (geometry.cones.len() as u32, geometry.sheets.len() as u32);
         // Per primitive, a wedge's three triangles or a sheet's two (see penumbra.vert); partial
         // silhouettes' sheets in the sheets' pass, after them.
@@ -447,7 +462,7 @@ impl Technique for Plateau {
             let pass = RenderPass::begin(ctx, cmd, &[color], None);
             for &(side, first, count) in draws.iter().filter(|d| d.2 > 0) {
                 let Some(primitives) = self.primitives.as_ref() else { break };
-                let penumbra = self.penumbrae.get((centred, overlaps, side), |&(centred, overlaps, side)| {
+                let penumbra = self.penumbrae.get((centred, overlaps, side), move |&(centred, overlaps, side)| {
                     let constants = [
                         ("CENTRED", centred as u32),
                         ("OVERLAPS", overlaps as u32),
@@ -455,8 +470,9 @@ impl Technique for Plateau {
                         ("PARTIAL", (side == Side::Partial) as u32),
                     ];
                     let (vert, frag) = (&shaders::PLATEAU_PENUMBRA_VERT, &shaders::PLATEAU_PENUMBRA_FRAG);
+                    let formats = [texture_format];
                     let desc = PipelineDesc::new("penumbra", vert, frag)
-                        .colors(&[PLATEAU_FORMAT])
+                        .colors(&formats)
                         .blend(Blend::Min)
                         .constants(&constants);
                     Pipeline::new(ctx, &desc)
@@ -477,9 +493,14 @@ impl Technique for Plateau {
         let inputs =
             [&surface_inputs(frame, view_range)[..], &[Descriptor::Image(texture), Descriptor::Image(mask)]].concat();
         let format = self.visibility;
-        let key = (params.get(&CURVE) as u32, params.is_on(&OFF_PLANE), centred);
-        let pipeline = self.resolves.get(key, |&(curve, off_plane, centred)| {
-            let constants = [("FALLOFF", curve), ("OFF_PLANE_MAP", off_plane as u32), ("CENTRED", centred as u32)];
+        let key = (params.get(&CURVE) as u32, params.is_on(&OFF_PLANE), centred, channels);
+        let pipeline = self.resolves.get(key, |&(curve, off_plane, centred, channels)| {
+            let constants = [
+                ("FALLOFF", curve),
+                ("OFF_PLANE_MAP", off_plane as u32),
+                ("CENTRED", centred as u32),
+                ("CHANNELS", channels as u32),
+            ];
             let desc = Fullscreen::new("resolve", &shaders::PLATEAU_RESOLVE_FRAG, format).constants(&constants);
             Pipeline::fullscreen(ctx, &desc)
         })?;

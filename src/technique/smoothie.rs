@@ -5,7 +5,7 @@
 //! in R32F or the paper's 16-bit float), `smoothie_buffer` (the smoothie edges and corners drawn
 //! from the light into depth b and remapped alpha α' = α / (1 − b/r) at once, packed in one
 //! 16-bit two-channel target with minimum blending, b as a logarithmic code: see
-//! [`smoothie_formats`]), `resolve` (the two depth comparisons at the four nearest texels, then
+//! [`Buffer`]), `resolve` (the two depth comparisons at the four nearest texels, then
 //! the falloff; in two draws, the second only where a smoothie is near: see
 //! [`MaskedResolve::record`]).
 //!
@@ -20,9 +20,9 @@
 //! Penumbra (issue 20, the `penumbra` knob): the paper's smoothies grow outward only, so the
 //! whole hard shadow stays umbra and a physical size only darkens (§3). Centred, each edge also
 //! gets an inner quad over its blocker (`geometry::smoothie`), drawn into more channels of the
-//! smoothie buffer (α and, in a second target, 1 − b, minimum-blended too: the shallowest inner
-//! alpha, as the blocker is the intersection of its edges' half planes, and the farthest inner
-//! depth, which errs dark), the resolve maps the distance over the whole
+//! smoothie buffer (α and 1 − b, minimum-blended too: the shallowest inner alpha, as the blocker
+//! is the intersection of its edges' half planes, and the farthest inner depth, which errs dark;
+//! with several casters 1 − b takes a second target, see [`Buffer`]), the resolve maps the distance over the whole
 //! width, t = ½ ± ½α' on the lit and the shadowed side, through the
 //! falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light grows, vanishing
 //! once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
@@ -215,26 +215,59 @@ const DEPTH_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 const MASK_FORMAT: vk::Format = vk::Format::D16_UNORM;
 /// The largest finite 16-bit float.
 const HALF_MAX: f32 = 65504.0;
-/// The smoothie buffer's targets. Outer only: depth b (as a code in [0, 1],
-/// glsl/smoothie/depth.glsl) and remapped alpha α'. Centred: b, α' of the even and of the odd
-/// casters, the inner quads' α (with their channel), and in a second target their 1 − b
-/// (glsl/smoothie/centred.frag). Minimum blending throughout. Unsigned normalized 16-bit
-/// channels where the device blends into them (Vulkan does not require it), else 32-bit floats
-/// holding the same codes.
-fn smoothie_formats(ctx: &Context, centred: bool) -> Vec<vk::Format> {
-    let pick = |unorm, float| if ctx.renders_blended(unorm) { unorm } else { float };
-    if centred {
-        vec![
-            pick(vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT),
-            pick(vk::Format::R16_UNORM, vk::Format::R32_SFLOAT),
-        ]
-    } else {
-        vec![pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)]
+/// What the smoothie buffer holds, which its fragment shader writes and the resolve reads: the
+/// technique builds the smallest the scene allows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Buffer {
+    /// The paper's: depth b (as a code in [0, 1], glsl/smoothie/depth.glsl) and remapped alpha
+    /// α' (glsl/smoothie/smoothie.frag).
+    Outer,
+    /// Centred, one caster: b, α', the inner quads' 1 − b and α (glsl/smoothie/centred_one.frag).
+    Centred,
+    /// Centred, several casters: b, α' of the even and of the odd casters, the inner quads' α
+    /// (with their channel), and in a second target their 1 − b (glsl/smoothie/centred.frag).
+    Channels,
+}
+
+impl Buffer {
+    const ALL: [Buffer; 3] = [Buffer::Outer, Buffer::Centred, Buffer::Channels];
+
+    fn new(centred: bool, casters: usize) -> Self {
+        match (centred, casters) {
+            (false, _) => Buffer::Outer,
+            (true, 0 | 1) => Buffer::Centred,
+            (true, _) => Buffer::Channels,
+        }
+    }
+
+    fn centred(self) -> bool {
+        self != Buffer::Outer
+    }
+
+    fn fragment_shader(self) -> &'static shaders::Shader {
+        match self {
+            Buffer::Outer => &shaders::SMOOTHIE_SMOOTHIE_FRAG,
+            Buffer::Centred => &shaders::SMOOTHIE_CENTRED_ONE_FRAG,
+            Buffer::Channels => &shaders::SMOOTHIE_CENTRED_FRAG,
+        }
+    }
+
+    /// Its targets' formats, minimum-blended: unsigned normalized 16-bit channels where the
+    /// device blends into them (Vulkan does not require it), else 32-bit floats holding the
+    /// same codes.
+    fn formats(self, ctx: &Context) -> Vec<vk::Format> {
+        let pick = |unorm, float| if ctx.renders_blended(unorm) { unorm } else { float };
+        let rgba = pick(vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT);
+        match self {
+            Buffer::Outer => vec![pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)],
+            Buffer::Centred => vec![rgba],
+            Buffer::Channels => vec![rgba, pick(vk::Format::R16_UNORM, vk::Format::R32_SFLOAT)],
+        }
     }
 }
 
-/// A resolve pipeline's specialization: falloff curve, centred, same grid.
-type ResolveKey = (u32, bool, bool);
+/// A resolve pipeline's specialization: falloff curve, buffer, same grid.
+type ResolveKey = (u32, Buffer, bool);
 
 /// The resolve's two draws' pipelines and the target between them.
 #[derive(Default)]
@@ -260,12 +293,13 @@ impl MaskedResolve {
     ) -> Result<()> {
         let (ctx, cmd) = (frame.ctx, frame.cmd);
         let pipeline = |mask: bool, depth: DepthState| {
-            move |&(curve, centred, same_grid): &ResolveKey| {
+            move |&(curve, buffer, same_grid): &ResolveKey| {
                 let constants = [
                     ("FALLOFF", curve),
-                    ("CENTRED", u32::from(centred)),
+                    ("CENTRED", u32::from(buffer.centred())),
                     ("SAME_GRID", u32::from(same_grid)),
                     ("MASK", u32::from(mask)),
+                    ("CHANNELS", u32::from(buffer == Buffer::Channels)),
                 ];
                 let formats = [format];
                 let desc =
@@ -337,15 +371,15 @@ struct CasterSilhouette {
 
 pub struct Smoothie {
     pass: ShadowMapPass,
-    /// The smoothie pass, by centring (the buffer's format).
-    smoothie: Variants<bool>,
-    /// The smoothie buffer's formats, outer only and centred.
-    buffer_formats: [Vec<vk::Format>; 2],
+    /// The smoothie pass, by what its buffer holds.
+    smoothie: Variants<Buffer>,
+    /// The smoothie buffer's formats, by [`Buffer`] (in the order of [`Buffer::ALL`]).
+    buffer_formats: [Vec<vk::Format>; 3],
     resolve: MaskedResolve,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     vertices: Option<PerFrame>,
-    /// The smoothie buffer and, centred, the inner quads' depths.
+    /// The smoothie buffer and, centred with several casters, the inner quads' depths.
     buffer: [Option<Target>; 2],
     silhouettes: Vec<Option<CasterSilhouette>>,
     /// The meshes the shadow map draws: the smoothies' own (`shadow_mesh_error`).
@@ -361,7 +395,7 @@ impl Smoothie {
         Ok(Smoothie {
             pass: pass.keep(),
             smoothie: Variants::default(),
-            buffer_formats: [smoothie_formats(ctx, false), smoothie_formats(ctx, true)],
+            buffer_formats: Buffer::ALL.map(|b| b.formats(ctx)),
             resolve: MaskedResolve::default(),
             visibility,
             vertices: None,
@@ -506,13 +540,13 @@ impl Technique for Smoothie {
             }
         };
 
-        let formats = &self.buffer_formats[usize::from(centred)];
+        let layout = Buffer::new(centred, cast.iter().flatten().count());
+        let formats = &self.buffer_formats[layout as usize];
         for ((target, &format), name) in self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner depths"]) {
             ensure(ctx, target, TargetDesc::color(name, format, buffer_size, buffer_size))?;
         }
-        let smoothie = self.smoothie.get(centred, |&centred| {
-            let fragment = if centred { &shaders::SMOOTHIE_CENTRED_FRAG } else { &shaders::SMOOTHIE_SMOOTHIE_FRAG };
-            let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, fragment)
+        let smoothie = self.smoothie.get(layout, |&layout| {
+            let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, layout.fragment_shader())
                 .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1]))
                 .colors(formats)
                 .blend(Blend::Min);
@@ -541,15 +575,15 @@ impl Technique for Smoothie {
         let mut reads: Vec<_> = targets.iter_mut().flatten().map(|t| (t, Access::FRAGMENT_READ, false)).collect();
         transition(ctx, cmd, &mut reads);
         let buffer = self.buffer[0].as_ref().expect("ensured");
-        // Outer only, the resolve reads no inner depths: the buffer stands in for them.
-        let inner = self.buffer[1].as_ref().filter(|_| centred).unwrap_or(buffer);
+        // Without a target of inner depths the resolve reads none: the buffer stands in.
+        let inner = self.buffer[1].as_ref().filter(|_| layout == Buffer::Channels).unwrap_or(buffer);
         let inputs = [
             &surface_inputs(frame, light)[..],
             &[Descriptor::Image(map), Descriptor::Image(buffer), Descriptor::Image(inner)],
         ]
         .concat();
         // One frustum for both: equal sizes put the buffer's texels on the map's.
-        let key = (params.get(&SMOOTHIE_FALLOFF) as u32, centred, buffer_size == size);
+        let key = (params.get(&SMOOTHIE_FALLOFF) as u32, layout, buffer_size == size);
         self.resolve.record(frame, self.visibility, key, visibility, &inputs)
     }
 

@@ -43,6 +43,26 @@ pub fn suite_scene(name: &str) -> Scene {
     Scene::load(format!("{}/scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))).expect("a scene of the suite")
 }
 
+/// The sphere scene (a sphere of radius 0.6 at (0, 1.3, 0)) with objects of its own before and
+/// after, as TOML: a technique that builds for one caster or for several sees another scene,
+/// the shadows are the same.
+pub fn sphere_with(before: &str, after: &str) -> Scene {
+    let path = format!("{}/scenes/sphere.toml", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(path).expect("the sphere scene");
+    scene(&format!("{before}\n{text}\n{after}"))
+}
+
+/// A box too small to matter, at the sphere's centre (see [`sphere_with`]): a second caster
+/// that changes no shadow.
+pub const HIDDEN_IN_THE_SPHERE: &str =
+    "[[object]]\nshape = \"box\"\nsize = [0.05, 0.05, 0.05]\nposition = [0.0, 1.3, 0.0]\n";
+
+/// The largest difference of V between two captures of one size.
+pub fn largest_difference(a: &Capture, b: &Capture) -> f32 {
+    let v = |x: &u16| *x as f32 / 65535.0;
+    a.visibility.iter().zip(&b.visibility).map(|(x, y)| (v(x) - v(y)).abs()).fold(0.0, f32::max)
+}
+
 /// The ground truth the accuracy bounds are stated against: the GPU reference with 256 light
 /// samples (512² maps, which keeps lavapipe quick).
 pub fn reference(e: &mut Engine, s: &Scene, size: u32) -> Capture {
