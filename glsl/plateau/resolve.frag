@@ -29,11 +29,11 @@ layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
 // One texel's curve parameters. Outer only: t, 0 inside the mask. Centred, per channel (odd
-// and even casters, see penumbra.frag; one caster's in r alone): t, or −t in the channel of the caster whose hard shadow
-// covers the texel; and where either channel is umbra (s ≤ −1, V = 0 whatever the other says),
-// both are. Where two casters' hard shadows abut, the channels swap roles between texels (one
-// caster's umbra beside the other's outer band), and interpolated apart they drew a lit seam
-// through the umbra (V up to 0.1 on overlap's ground).
+// and even casters, see penumbra.frag; one caster's in r alone): t, or −t in the channel of the
+// caster whose hard shadow covers the texel; and where either channel is umbra (s ≤ −1, V = 0
+// whatever the other says), both are. Where two casters' hard shadows abut, the channels swap
+// roles between texels (one caster's umbra beside the other's outer band), and interpolated
+// apart they drew a lit seam through the umbra (V up to 0.1 on overlap's ground).
 // `t`: the texel's plateau parameters (both channels), `caster`: its mask's caster number.
 vec2 texel_s(vec2 t, uint caster) {
     if (!CENTRED) {

@@ -22,8 +22,8 @@
 //! gets an inner quad over its blocker (`geometry::smoothie`), drawn into more channels of the
 //! smoothie buffer (α and 1 − b, minimum-blended too: the shallowest inner alpha, as the blocker
 //! is the intersection of its edges' half planes, and the farthest inner depth, which errs dark;
-//! with several casters 1 − b takes a second target, see [`Buffer`]), the resolve maps the distance over the whole
-//! width, t = ½ ± ½α' on the lit and the shadowed side, through the
+//! with several casters 1 − b takes a second target, see [`Buffer`]), the resolve maps the
+//! distance over the whole width, t = ½ ± ½α' on the lit and the shadowed side, through the
 //! falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light grows, vanishing
 //! once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
 //! fragment only where its edge bounds its own caster's hard shadow (nothing in the map just
