@@ -236,7 +236,9 @@ struct SidesKey {
 }
 
 pub struct Plateau {
-    umbra: Pipeline,
+    /// The umbra pass for one caster, and for several, whose depth test keeps the lowest
+    /// caster's number where their hard shadows overlap: one caster needs no depth target.
+    umbra: [Pipeline; 2],
     /// Side pipelines by centring, whether several casters' shadows may overlap, and the kind
     /// of side.
     penumbrae: Variants<(bool, bool, Side)>,
@@ -272,19 +274,28 @@ struct CasterSides {
 impl Plateau {
     /// `visibility`: the format of the V target the resolve writes.
     pub fn new(ctx: &Context, visibility: vk::Format) -> Result<Self> {
-        let depth = DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::LESS);
-        let umbra = PipelineDesc::new("umbra", &shaders::PLATEAU_UMBRA_VERT, &shaders::PLATEAU_UMBRA_FRAG)
-            .vertex_input(MESH_POSITIONS)
-            .colors(&[MASK_FORMAT])
-            .depth(depth)
-            // The depth orders casters, it must not clip them: only w > 0 may cut a caster
-            // reaching above the light, whose umbra runs to the horizon.
-            .depth_clamp();
-        let umbra = Guard::new(ctx, Pipeline::new(ctx, &umbra)?);
+        let umbra = |depth: Option<DepthState>| {
+            let desc = PipelineDesc::new("umbra", &shaders::PLATEAU_UMBRA_VERT, &shaders::PLATEAU_UMBRA_FRAG)
+                .vertex_input(MESH_POSITIONS)
+                .colors(&[MASK_FORMAT])
+                // The depth orders casters, it must not clip them: only w > 0 may cut a caster
+                // reaching above the light, whose umbra runs to the horizon.
+                .depth_clamp();
+            Pipeline::new(
+                ctx,
+                &match depth {
+                    Some(depth) => desc.depth(depth),
+                    None => desc,
+                },
+            )
+        };
+        let one = Guard::new(ctx, umbra(None)?);
+        let several =
+            Guard::new(ctx, umbra(Some(DepthState::test_write(vk::Format::D32_SFLOAT, vk::CompareOp::LESS)))?);
         let size = std::mem::size_of::<PlateauView>() as u64;
         let view = PerFrame::new(ctx, "plateau view", size, FRAMES_IN_FLIGHT, vk::BufferUsageFlags::UNIFORM_BUFFER)?;
         Ok(Plateau {
-            umbra: umbra.keep(),
+            umbra: [one.keep(), several.keep()],
             penumbrae: Variants::default(),
             resolves: Variants::default(),
             formats: [
@@ -385,7 +396,9 @@ impl Technique for Plateau {
         let texture_format = self.formats[usize::from(channels)];
         ensure(ctx, &mut self.texture, TargetDesc::color("plateau texture", texture_format, tex_size, tex_size))?;
         ensure(ctx, &mut self.mask, TargetDesc::color("plateau mask", MASK_FORMAT, tex_size, tex_size))?;
-        ensure(ctx, &mut self.depth, TargetDesc::depth("plateau depth", tex_size, tex_size))?;
+        if overlaps {
+            ensure(ctx, &mut self.depth, TargetDesc::depth("plateau depth", tex_size, tex_size))?;
+        }
         let Some(window) = self.window(&plane, &geometry, frame) else {
             return clear_visibility(frame, visibility);
         };
@@ -426,17 +439,21 @@ impl Technique for Plateau {
         let sides = &self.sides;
         self.casters.prepare(frame, |i| sides.get(i).and_then(Option::as_ref).map(|c| &c.mesh))?;
         let texture = self.texture.as_mut().expect("ensured");
-        let (mask, depth) = (self.mask.as_mut().expect("ensured"), self.depth.as_mut().expect("ensured"));
+        let mask = self.mask.as_mut().expect("ensured");
         // umbra: the mask cleared to 0 (no caster), then the flattened casters, the lowest nearest.
         frame.timer.begin(ctx, cmd, "umbra");
-        transition(ctx, cmd, &mut [(mask, Access::COLOR_WRITE, true), (depth, Access::DEPTH_WRITE, true)]);
+        let mut depth = self.depth.as_mut().filter(|_| overlaps);
+        let mut writes = vec![(&mut *mask, Access::COLOR_WRITE, true)];
+        writes.extend(depth.as_deref_mut().map(|d| (d, Access::DEPTH_WRITE, true)));
+        transition(ctx, cmd, &mut writes);
         let pass = RenderPass::begin(
             ctx,
             cmd,
             &[Attachment::clear_color(mask, [0.0; 4])],
-            Some(Attachment::clear_depth(depth, 1.0)),
+            depth.map(|d| Attachment::clear_depth(d, 1.0)),
         );
-        self.umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)])?;
+        let umbra = &self.umbra[usize::from(overlaps)];
+        umbra.bind(ctx, cmd, &[Descriptor::Buffer(view_range), Descriptor::Buffer(frame.objects)])?;
         self.casters.record(frame);
         pass.end(ctx, cmd);
         frame.timer.end(ctx, cmd);
@@ -509,7 +526,7 @@ impl Technique for Plateau {
 
     fn destroy(self: Box<Self>, ctx: &Context) {
         let this = *self;
-        this.umbra.destroy(ctx);
+        this.umbra.into_iter().for_each(|p| p.destroy(ctx));
         this.penumbrae.destroy(ctx);
         this.resolves.destroy(ctx);
         this.view.destroy(ctx);
