@@ -8,8 +8,8 @@
 mod common;
 
 use common::{
-    HIDDEN_IN_THE_SPHERE, crossing, engine, error_minimising_scale, finish, largest_difference, reference, render_with,
-    sphere_with, suite_scene, terminator_error,
+    HIDDEN_IN_THE_SPHERE, crossing, engine, error_minimising_scale, finish, largest_difference, penumbra_pixels,
+    reference, render_with, sphere_with, suite_scene, terminator_error,
 };
 use softshadow::Capture;
 use softshadow::measure::Metrics;
@@ -168,7 +168,7 @@ fn one_caster_s_buffer_reads_as_the_channels_do() {
     assert_eq!(two.objects.len(), 2);
     let mut e = engine();
     let [a, b] = [&one, &two].map(|s| render_with(&mut e, s, "smoothie", CENTRED, 128));
-    let penumbra = a.visibility.iter().filter(|x| (0.02..0.98).contains(&(**x as f32 / 65535.0))).count();
+    let penumbra = penumbra_pixels(&a);
     let worst = largest_difference(&a, &b);
     eprintln!("{penumbra} penumbra px, largest difference {worst}");
     assert!(penumbra > 100, "a penumbra to compare: {penumbra} px");

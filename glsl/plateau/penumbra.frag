@@ -1,9 +1,9 @@
 #version 460
 // The plateau's sides write t, blended by min (the darkest wins, Haines §2), into channel r
-// (outer only, or one caster: the texture's only channel). Centred (issue 20), t is the distance to the hard shadow's boundary
-// in half widths on both of its sides, so only silhouettes on that boundary may write it: the
-// mask must be lit a couple of texels off the foot, across the edge (either way: an edge seen edge-on has no
-// reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
+// (outer only, or one caster: the texture's only channel). Centred (issue 20), t is the
+// distance to the hard shadow's boundary in half widths on both of its sides, so only
+// silhouettes on that boundary may write it: the mask must be lit a couple of texels off the
+// foot, across the edge (either way: an edge seen edge-on has no reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
 // has shadow on both sides and writes nothing, so no bright streak crosses the umbra.
 //
 // Overlapping casters. Each caster's bands go to one channel, r for odd caster numbers and g

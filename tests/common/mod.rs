@@ -7,6 +7,7 @@ pub mod embedder;
 pub mod xvfb;
 
 use softshadow::gpu::ContextOptions;
+use softshadow::measure::PENUMBRA;
 use softshadow::scene::Scene;
 use softshadow::technique::{Params, find};
 use softshadow::{Capture, Engine, FrameSettings};
@@ -56,6 +57,12 @@ pub fn sphere_with(before: &str, after: &str) -> Scene {
 /// that changes no shadow.
 pub const HIDDEN_IN_THE_SPHERE: &str =
     "[[object]]\nshape = \"box\"\nsize = [0.05, 0.05, 0.05]\nposition = [0.0, 1.3, 0.0]\n";
+
+/// How many pixels of `c` are in penumbra (V inside [`PENUMBRA`]).
+pub fn penumbra_pixels(c: &Capture) -> usize {
+    let (lo, hi) = PENUMBRA;
+    c.visibility.iter().filter(|&&x| (lo..hi).contains(&(f64::from(x) / 65535.0))).count()
+}
 
 /// The largest difference of V between two captures of one size.
 pub fn largest_difference(a: &Capture, b: &Capture) -> f32 {
