@@ -2,6 +2,7 @@
 #ifndef SOFTSHADOW_CAMERA_GLSL
 #define SOFTSHADOW_CAMERA_GLSL
 #include "interface.glsl"
+#include "disk.glsl"
 
 // Reverse Z: the prepass clears depth to 0, so 0 means "no surface".
 bool sees_surface(float depth) { return depth > 0.0; }
@@ -51,14 +52,12 @@ bool hides_itself(Surface s, vec3 q) {
 // The same for a spherical light (centre `c`, radius `radius`): the fraction of it that lies in
 // front of a caster's tangent plane, 1 for surfaces that cast nothing. The light seen from p is
 // a disk of angular radius a whose centre stands b above the horizon; the plane cuts it at
-// h = sin b / sin a of its radius, leaving the circular segment 1 - (acos h - h sqrt(1 - h^2)) / pi.
+// h = sin b / sin a of its radius (disk.glsl).
 float in_front_of_itself(Surface s, vec3 c, float radius) {
     if (!s.casts) return 1.0;
     vec3 to_light = c - s.p;
     float dist = length(to_light);
-    float h = clamp(dot(s.n, to_light) / max(radius, 1e-6 * dist), -1.0, 1.0);
-    // Clamped: near h = ±1 the two terms cancel and their rounding left V at 1.0000001 (issue 19).
-    return clamp(1.0 - (acos(h) - h * sqrt(1.0 - h * h)) / 3.14159265, 0.0, 1.0);
+    return disk_below(dot(s.n, to_light) / max(radius, 1e-6 * dist));
 }
 
 #endif

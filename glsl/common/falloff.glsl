@@ -6,6 +6,7 @@
 // the curve is exact instead of interpolated between 256 entries.
 #ifndef SOFTSHADOW_FALLOFF_GLSL
 #define SOFTSHADOW_FALLOFF_GLSL
+#include "disk.glsl"
 
 // The `falloff` knob: which curve a resolve takes. Shaders including this file leave
 // constant_id 8 to it.
@@ -25,8 +26,7 @@ float falloff_at(float t) {
     } else if (FALLOFF == 3) {
         // The visible fraction of a spherical light whose centre sits at t across a straight
         // edge: the disk segment beyond the chord at u = 2t − 1, ½ on the hard edge.
-        float u = 2.0 * t - 1.0;
-        v = 1.0 - (acos(u) - u * sqrt(1.0 - u * u)) / FALLOFF_PI;
+        v = disk_below(2.0 * t - 1.0);
     }
     return clamp(v, 0.0, 1.0);
 }

@@ -6,7 +6,8 @@
 //
 // Target 0: the outer smoothies' nearest depth b (its code, depth.glsl), their remapped alpha
 // α' (Equation 1) in two channels, one per caster parity (SmoothieVertex::channel), and the
-// inner quads' alpha α. Target 1: the inner quads' 1 − code(b), the farthest inner depth.
+// inner quads' alpha α. Target 1: the inner quads' 1 − code(b), the farthest inner depth, and
+// their limit (centred.glsl), the nearest.
 //
 // Two outer channels: the resolve multiplies their visibilities. Where two casters' penumbrae
 // cross, the light each hides is about independent of the other's (at the crossing of two hard
@@ -26,7 +27,7 @@
 #include "centred.glsl"
 
 layout(location = 0) out vec4 out_smoothie;
-layout(location = 1) out float out_inner_depth;
+layout(location = 1) out vec2 out_inner_depth;
 
 // α with the channel in its lowest bit, as a 16-bit unsigned normalized value (32-bit floats
 // hold the same code exactly); resolve.frag's texels() reads it back.
@@ -41,10 +42,10 @@ void main() {
     }
     if (c.inner) {
         out_smoothie = vec4(1.0, 1.0, 1.0, with_channel(c.alpha, in_channel));
-        out_inner_depth = 1.0 - c.code;
+        out_inner_depth = vec2(1.0 - c.code, c.limit);
         return;
     }
     bool even = in_channel == 0.0;
     out_smoothie = vec4(c.code, even ? c.alpha : 1.0, even ? 1.0 : c.alpha, 1.0);
-    out_inner_depth = 1.0;
+    out_inner_depth = vec2(1.0);
 }

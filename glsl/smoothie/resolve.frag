@@ -31,7 +31,8 @@ layout(set = 0, binding = 4) uniform sampler2D shadow_map;
 // Outer only: b, α' (smoothie.frag). Centred: b, α' of even and of odd casters, inner α with its
 // channel (centred.frag); one caster: b, α', the inner quads' 1 − b and α (centred_one.frag).
 layout(set = 0, binding = 5) uniform sampler2D smoothies;
-// Centred, several casters: 1 − b of the inner quads (depth.glsl codes); else unread.
+// Centred, several casters: 1 − b of the inner quads and their limits (depth.glsl codes); else
+// unread.
 layout(set = 0, binding = 6) uniform sampler2D inner_depths;
 
 layout(location = 0) in vec2 in_uv;
@@ -52,6 +53,11 @@ struct Texels {
     vec4 behind;     // 1 where the receiver lies behind the texel's outer smoothie
 };
 
+// How far past an inner quad's limit a receiver still counts as the surface there, in depth
+// codes (depth.glsl): a 2 % deeper depth, more than a caster's own face slants across the
+// few texels between the limit's probe and the inner half.
+#define LIMIT_SLACK (log2(1.02) / light.depths.z)
+
 const ivec2 GATHER_ORDER[4] = ivec2[4](ivec2(0, 1), ivec2(1, 1), ivec2(1, 0), ivec2(0, 0));
 
 // Where a lookup falls in the smoothie buffer, in texels from texel (0, 0)'s centre.
@@ -66,8 +72,11 @@ Texels texels(vec2 uv, float depth) {
     vec2 pos = smoothie_pos(uv);
     t.base = ivec2(pos);
     t.f = fract(pos);
+    vec4 limit = vec4(1.0);
     if (CENTRED && CHANNELS) {
-        t.inner_b = 1.0 - textureGather(inner_depths, (vec2(t.base) + 1.0) / light.kernel.x, 0);
+        vec2 corner = (vec2(t.base) + 1.0) / light.kernel.x;
+        t.inner_b = 1.0 - textureGather(inner_depths, corner, 0);
+        limit = textureGather(inner_depths, corner, 1);
     }
     for (int k = 0; k < 4; k++) {
         vec4 texel = texelFetch(smoothies, t.base + GATHER_ORDER[k], 0);
@@ -77,7 +86,8 @@ Texels texels(vec2 uv, float depth) {
             t.outer_odd[k] = texel.z;
             // The channel in the alpha's lowest bit (centred.frag's with_channel).
             uint coded = uint(round(texel.w * 65535.0));
-            t.inner[k] = float(coded >> 1u) / 32767.0;
+            // Beyond its limit (centred.glsl) the receiver may not see past the edge: umbra.
+            t.inner[k] = code > limit[k] + LIMIT_SLACK ? 1.0 : float(coded >> 1u) / 32767.0;
             t.inner_odd[k] = float(coded & 1u);
         } else if (CENTRED) {
             t.outer_odd[k] = 1.0;

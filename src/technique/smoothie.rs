@@ -22,14 +22,17 @@
 //! gets an inner quad over its blocker (`geometry::smoothie`), drawn into more channels of the
 //! smoothie buffer (α and 1 − b, minimum-blended too: the shallowest inner alpha, as the blocker
 //! is the intersection of its edges' half planes, and the farthest inner depth, which errs dark;
-//! with several casters 1 − b takes a second target, see [`Buffer`]), the resolve maps the
-//! distance over the whole width, t = ½ ± ½α' on the lit and the shadowed side, through the
-//! falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light grows, vanishing
-//! once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
+//! with several casters 1 − b and a limit take a second target, see [`Buffer`]), the resolve
+//! maps the distance over the whole width, t = ½ ± ½α' on the lit and the shadowed side,
+//! through the falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light
+//! grows, vanishing once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
 //! fragment only where its edge bounds its own caster's hard shadow (nothing in the map just
-//! outside the edge: no fold of the same caster, no other caster there) and the map's blocker at
-//! the fragment is that caster (its depth inside the caster's range): one caster's inner half
-//! never lightens what another blocks, and interior silhouettes (folds) stay umbra.
+//! outside the edge within the caster's depth range: no fold of the same caster, no other caster
+//! abutting it) and the map's blocker at the fragment is that caster (its depth inside the
+//! caster's range): one caster's inner half never lightens what another blocks, and interior
+//! silhouettes (folds) stay umbra. A caster wholly behind it outside the edge (the lower of two
+//! boxes) takes the inner half down to its own depth, the inner quad's limit: past it, the
+//! receivers it hides stay umbra.
 //!
 //! Overlapping casters, centred: each caster's α' goes to one of two channels by the parity of
 //! its number, and the resolve multiplies the two channels' visibilities (as the plateau's
@@ -225,7 +228,8 @@ enum Buffer {
     /// Centred, one caster: b, α', the inner quads' 1 − b and α (glsl/smoothie/centred_one.frag).
     Centred,
     /// Centred, several casters: b, α' of the even and of the odd casters, the inner quads' α
-    /// (with their channel), and in a second target their 1 − b (glsl/smoothie/centred.frag).
+    /// (with their channel), and in a second target their 1 − b and their limit
+    /// (glsl/smoothie/centred.frag).
     Channels,
 }
 
@@ -261,7 +265,7 @@ impl Buffer {
         match self {
             Buffer::Outer => vec![pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)],
             Buffer::Centred => vec![rgba],
-            Buffer::Channels => vec![rgba, pick(vk::Format::R16_UNORM, vk::Format::R32_SFLOAT)],
+            Buffer::Channels => vec![rgba, pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)],
         }
     }
 }
