@@ -140,12 +140,16 @@ impl FarLight for Scene {
 #[test]
 fn a_point_light_gives_exactly_the_hard_shadow_and_16_bit_depth_costs_little() {
     let mut e = engine();
+    // two_boxes: the lower box's flat top, lit, where a half float's rounding outgrew the bias.
+    for name in ["plate", "two_boxes"] {
+        let s = suite_scene(name);
+        let full = render_with(&mut e, &s, "smoothie", &[], 64);
+        let half = render_with(&mut e, &s, "smoothie", &[("depth16", "1")], 64);
+        let m = Metrics::between(&half, &full).unwrap();
+        eprintln!("{name}: 16-bit vs 32-bit depth: RMSE {:.5}, max {:.4}", m.rmse, m.max_abs);
+        assert!(m.rmse < 0.02, "{name}: {m:?}");
+    }
     let mut plate = suite_scene("plate");
-    let full = render_with(&mut e, &plate, "smoothie", &[], 64);
-    let half = render_with(&mut e, &plate, "smoothie", &[("depth16", "1")], 64);
-    let m = Metrics::between(&half, &full).unwrap();
-    eprintln!("16-bit vs 32-bit depth: RMSE {:.5}, max {:.4}", m.rmse, m.max_abs);
-    assert!(m.rmse < 0.02, "{m:?}");
     plate.light.radius = 0.0;
     let smoothie = render_with(&mut e, &plate, "smoothie", &[("shadow_map_size", "2048")], 64);
     let hard = render_with(&mut e, &plate, "shadow-map", &[], 64);

@@ -33,7 +33,7 @@ struct LightView {
     vec4 kernel;     // PCF: taps, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
                      // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
                      // smoothie: buffer size, an empty map texel's depth, ground height, light height
-    vec4 depths;     // the frustum's linear depth range: near, far, log2(far / near), 0
+    vec4 depths;     // the frustum's linear depth range: near, far, log2(far / near); the map's rounding
 };
 
 // A point sampled on the area light and the view its shadow map was rendered through (the

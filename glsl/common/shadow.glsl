@@ -13,9 +13,10 @@
 // and shadows its own lit faces.
 const float DEPTH_ROUNDING = 8.0 * 1.1920929e-7;
 
-// The world distance the depths of a receiver at `p`, light depth `z`, may round by.
+// The world distance the depths of a receiver at `p`, light depth `z`, may round by, and the
+// map's format (depths.w, relative: a 16-bit float's ulp, or 0) on top.
 float depth_rounding(LightView light, vec3 p, float z) {
-    return DEPTH_ROUNDING * max(abs(z), max(length(p), length(light.view[3].xyz)));
+    return DEPTH_ROUNDING * max(abs(z), max(length(p), length(light.view[3].xyz))) + light.depths.w * abs(z);
 }
 
 // The radius of the light `radius` wide at `from` as seen from the projection centre of

@@ -37,7 +37,8 @@ pub struct LightView {
     pub extent: Vec4,
     pub bias: Vec4,
     pub kernel: Vec4,
-    /// The frustum's linear depth range: near, far, log2(far / near), 0.
+    /// The frustum's linear depth range: near, far, log2(far / near); then how far the map's
+    /// format may round a depth, relative to it (0 for 32-bit floats).
     pub depths: Vec4,
 }
 
