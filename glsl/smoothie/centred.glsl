@@ -30,9 +30,9 @@ bool centred_fragment(out Centred c) {
         // the edge. Another caster wholly behind it there (under it: the lower of two boxes)
         // hides that light only from what lies behind that caster, not from its own surface: the
         // inner half holds down to its depth, `limit` (the resolve; one caster has no other, and
-        // its limit is always 1). Dropped whenever anything was cast outside, the upper box's
-        // inner half left its shadow on the lower one's top hard (two_boxes' penumbra RMSE
-        // 0.103, 0.049 with the limit).
+        // its limit is always 1). Dropped wherever anything was cast outside, it left the upper
+        // box's shadow on the lower one's top a hard inner edge (two_boxes' penumbra RMSE 0.103;
+        // 0.049 with the limit).
         float slack = 2.0 * in_b * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
         bool own = caster >= in_range.x - slack && caster <= in_range.y + slack;
         float outside = map_at(in_probe);

@@ -25,14 +25,14 @@
 //! with several casters 1 − b and a limit take a second target, see [`Buffer`]), the resolve
 //! maps the distance over the whole width, t = ½ ± ½α' on the lit and the shadowed side,
 //! through the falloff curve, so V = ½ on the hard edge and the umbra shrinks as the light
-//! grows, vanishing once the inner halves from both sides of a blocker meet. The smoothie pass accepts an inner
-//! fragment only where its edge bounds its own caster's hard shadow (nothing in the map just
-//! outside the edge within the caster's depth range: no fold of the same caster, no other caster
-//! abutting it) and the map's blocker at the fragment is that caster (its depth inside the
-//! caster's range): one caster's inner half never lightens what another blocks, and interior
-//! silhouettes (folds) stay umbra. A caster wholly behind it outside the edge (the lower of two
-//! boxes) takes the inner half down to its own depth, the inner quad's limit: past it, the
-//! receivers it hides stay umbra.
+//! grows, vanishing once the inner halves from both sides of a blocker meet. The smoothie pass
+//! accepts an inner fragment only where its edge bounds its own caster's hard shadow (nothing in
+//! the map just outside the edge within the caster's depth range: no fold of the same caster, no
+//! other caster abutting it) and the map's blocker at the fragment is that caster (its depth
+//! inside the caster's range): one caster's inner half never lightens what another blocks, and
+//! interior silhouettes (folds) stay umbra. A caster wholly behind it outside the edge (the lower
+//! of two boxes) takes the inner half down to its own depth, the inner quad's limit: past it,
+//! the receivers it hides stay umbra.
 //!
 //! Overlapping casters, centred: each caster's α' goes to one of two channels by the parity of
 //! its number, and the resolve multiplies the two channels' visibilities (as the plateau's
