@@ -3,8 +3,9 @@
 // (outer only, or one caster: the texture's only channel). Centred (issue 20), t is the
 // distance to the hard shadow's boundary in half widths on both of its sides, so only
 // silhouettes on that boundary may write it: the mask must be lit a couple of texels off the
-// foot, across the edge (either way: an edge seen edge-on has no reliable outward side). An interior fold (a torus's far rim, the cow's legs under its body)
-// has shadow on both sides and writes nothing, so no bright streak crosses the umbra.
+// foot, across the edge (either way: an edge seen edge-on has no reliable outward side). An
+// interior fold (a torus's far rim, the cow's legs under its body) has shadow on both sides and
+// writes nothing, so no bright streak crosses the umbra.
 //
 // Overlapping casters. Each caster's bands go to one channel, r for odd caster numbers and g
 // for even ones, and the resolve multiplies the two channels' visibilities: blockers in
