@@ -14,7 +14,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec3};
 use softshadow::geometry::plateau::{self, PenumbraSize, PlateauLight, ReceiverPlane, caster_sides};
 use softshadow::geometry::silhouette::{Caster, EdgeSource, partial_silhouettes, penumbra_edges};
-use softshadow::geometry::smoothie::{self, SmoothieSize, depth_range, partial_smoothies, smoothies};
+use softshadow::geometry::smoothie::{self, ReceiverBound, SmoothieSize, depth_range, partial_smoothies, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::{Mesh, Object, Transform};
 use softshadow::technique::shadow_mesh::texels_at_caster;
@@ -55,7 +55,8 @@ fn scale(c: &mut Criterion) {
     let bounds = Aabb::from_points(positions.iter().copied());
     let ground = [(-6.0, -6.0), (6.0, -6.0), (6.0, 6.0), (-6.0, 6.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the koala is in view");
-    let size = (SmoothieSize::Physical { light_radius: 0.3, scale: 1.0, behind: 0.0 }, frustum.far);
+    let size =
+        (SmoothieSize::Physical { light_radius: 0.3, scale: 1.0, behind: 0.0 }, ReceiverBound::up_to(frustum.far));
     // The full mesh, and the one-texel shadow mesh both techniques cast from by default (built
     // once, when the caster first casts, and cached).
     let world = texels_at_caster(&o, light, 1.0).expect("the light is outside the koala");

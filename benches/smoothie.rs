@@ -11,7 +11,7 @@ use glam::{Mat4, Vec3};
 use softshadow::geometry::fit_spot_frustum;
 use softshadow::geometry::silhouette::Caster;
 use softshadow::geometry::smoothie::{
-    Penumbra, SmoothieSize, merged_silhouette, merged_smoothies, silhouette, smoothies,
+    Penumbra, ReceiverBound, SmoothieSize, merged_silhouette, merged_smoothies, silhouette, smoothies,
 };
 use softshadow::scene::Mesh;
 
@@ -32,7 +32,8 @@ fn smoothie(c: &mut Criterion) {
     let ground = [(-3.0, -3.0), (3.0, -3.0), (3.0, 3.0), (-3.0, 3.0)].map(|(x, z)| Vec3::new(x, 0.0, z));
     let frustum = fit_spot_frustum(light, None, &[bounds], &ground).frustum.expect("the model is in view");
     let view = frustum.view * model;
-    let size = (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, frustum.far);
+    let size =
+        (SmoothieSize::Physical { light_radius: 0.4, scale: 1.0, behind: 0.0 }, ReceiverBound::up_to(frustum.far));
     group.bench_function("smoothie geometry", |b| {
         b.iter(|| smoothies(&view, black_box(&caster), &edges, size, Penumbra::Outer))
     });

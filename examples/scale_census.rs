@@ -13,7 +13,7 @@ use softshadow::geometry::plateau::{
     self, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, plateau_edges, plateau_sides,
 };
 use softshadow::geometry::silhouette::{Caster, EdgeSource, penumbra_edges};
-use softshadow::geometry::smoothie::{self, SmoothieSize, SmoothieVertex, depth_range, smoothies};
+use softshadow::geometry::smoothie::{self, ReceiverBound, SmoothieSize, SmoothieVertex, depth_range, smoothies};
 use softshadow::geometry::{Aabb, fit_spot_frustum};
 use softshadow::scene::Scene;
 use softshadow::technique::shadow_mesh::texels_at_caster;
@@ -109,7 +109,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let started = Instant::now();
         let (near, far) = depth_range(&frustum.view, &bounds);
         let penumbra = smoothie::Penumbra::Centred { near, far };
-        let g = smoothies(&frustum.view, &caster, &closed_edges, (size, frustum.far), penumbra);
+        let g = smoothies(&frustum.view, &caster, &closed_edges, (size, ReceiverBound::up_to(frustum.far)), penumbra);
         let smoothie_ms = started.elapsed().as_secs_f64() * 1e3;
         let [x0, y0, x1, y1] = frustum.window;
         let smoothie_texel = (texels * texels) / f64::from((x1 - x0) * (y1 - y0));

@@ -65,7 +65,9 @@ struct SilhouetteParams {
     vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE);
                       // y: the caster's channel in the centred smoothie buffer (0 or 1);
                       // z: centred, the light's radius (partial silhouettes), else 0; w: PARTIAL_GAIN
-    vec4 pad[9];
+    vec4 ground;      // xyz: the ground's inverse light depth along the ray (x, y, 1); w: 1 where it
+                      // bounds the receivers (src/geometry/smoothie.rs's ReceiverBound), else 0
+    vec4 pad[8];
 };
 
 // One caster's shadow volume from one light point, built on the GPU (shadow-volume,

@@ -1,20 +1,20 @@
 #version 460
-// The centred smoothie buffer (issue 20) of one caster: one target, minimum blending, every
-// channel cleared to 1. Its channels: the outer smoothies' nearest depth b (its code,
-// depth.glsl) and remapped alpha α' (Equation 1), the inner quads' 1 − code(b) (the farthest
-// inner depth) and alpha α (the shallowest, the lightest: see centred.frag). With no other
-// caster there are no channels to keep apart, so what centred.frag spreads over two targets
-// fits in one: 8 bytes a texel instead of 10, cleared everywhere and blended wherever a
-// smoothie lies, and the resolve reads the inner depths without a gather of their own (sphere,
-// 512², lavapipe, interleaved runs: the smoothie pass 5.5 → 4.8 ms, the resolve 10.4 → 9.5).
+// The centred smoothie buffer (issue 20) of one caster: two targets, minimum blending, every
+// channel cleared to 1. Target 0: the outer smoothies' nearest depth b (its code, depth.glsl)
+// and remapped alpha α' (Equation 1); target 1: the inner quads' 1 − code(b) (the farthest
+// inner depth) and alpha α (the shallowest, the lightest: see centred.frag), as centred.frag's
+// first two, less the channel bit. With no other caster there are no channels to keep apart
+// and no limits (one caster has no other beside it): centred.frag's third target is not needed.
 #include "centred.glsl"
 
-layout(location = 0) out vec4 out_smoothie;
+layout(location = 0) out vec2 out_outer;
+layout(location = 1) out vec2 out_inner;
 
 void main() {
     Centred c;
     if (!centred_fragment(c)) {
         discard;
     }
-    out_smoothie = c.inner ? vec4(1.0, 1.0, 1.0 - c.code, c.alpha) : vec4(c.code, c.alpha, 1.0, 1.0);
+    out_outer = c.inner ? vec2(1.0) : vec2(c.code, c.alpha);
+    out_inner = c.inner ? vec2(1.0 - c.code, c.alpha) : vec2(1.0);
 }

@@ -28,19 +28,19 @@ layout(set = 0, binding = 1) uniform Light { LightView light; };
 layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
 layout(set = 0, binding = 4) uniform sampler2D shadow_map;
-// Outer only: b, α' (smoothie.frag). Centred: b, α' of even and of odd casters, inner α with its
-// channel (centred.frag); one caster: b, α', the inner quads' 1 − b and α (centred_one.frag).
+// The outer smoothies' b and α' (smoothie.frag; centred: of the even casters, centred.frag).
 layout(set = 0, binding = 5) uniform sampler2D smoothies;
-// Centred, several casters: 1 − b of the inner quads and their limits (depth.glsl codes); else
-// unread.
-layout(set = 0, binding = 6) uniform sampler2D inner_depths;
+// Centred: the inner quads' 1 − b and α (depth.glsl codes), with several casters α's channel in
+// its lowest bit; else unread.
+layout(set = 0, binding = 6) uniform sampler2D inner_smoothies;
+// Centred, several casters: the odd casters' α' and the inner quads' limits; else unread.
+layout(set = 0, binding = 7) uniform sampler2D odd_smoothies;
 
 layout(location = 0) in vec2 in_uv;
 layout(location = 0) out float out_visibility;
 
 // The four smoothie texels around a lookup, in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0),
-// each fetched whole: llvmpipe runs every branch of a fragment shader, so one fetch of all
-// channels costs less than a gather per channel.
+// a gather per channel.
 struct Texels {
     ivec2 base;      // texel (i0, j0)
     vec2 f;          // bilinear weights
@@ -72,29 +72,23 @@ Texels texels(vec2 uv, float depth) {
     vec2 pos = smoothie_pos(uv);
     t.base = ivec2(pos);
     t.f = fract(pos);
-    vec4 limit = vec4(1.0);
-    if (CENTRED && CHANNELS) {
-        vec2 corner = (vec2(t.base) + 1.0) / light.kernel.x;
-        t.inner_b = 1.0 - textureGather(inner_depths, corner, 0);
-        limit = textureGather(inner_depths, corner, 1);
+    vec2 corner = (vec2(t.base) + 1.0) / light.kernel.x;
+    t.b = textureGather(smoothies, corner, 0);
+    t.outer = textureGather(smoothies, corner, 1);
+    t.outer_odd = vec4(1.0);
+    t.inner_odd = vec4(0.0);
+    if (CENTRED) {
+        t.inner_b = 1.0 - textureGather(inner_smoothies, corner, 0);
+        t.inner = textureGather(inner_smoothies, corner, 1);
     }
-    for (int k = 0; k < 4; k++) {
-        vec4 texel = texelFetch(smoothies, t.base + GATHER_ORDER[k], 0);
-        t.b[k] = texel.x;
-        t.outer[k] = texel.y;
-        if (CENTRED && CHANNELS) {
-            t.outer_odd[k] = texel.z;
-            // The channel in the alpha's lowest bit (centred.frag's with_channel).
-            uint coded = uint(round(texel.w * 65535.0));
-            // Beyond its limit (centred.glsl) the receiver may not see past the edge: umbra.
-            t.inner[k] = code > limit[k] + LIMIT_SLACK ? 1.0 : float(coded >> 1u) / 32767.0;
-            t.inner_odd[k] = float(coded & 1u);
-        } else if (CENTRED) {
-            t.outer_odd[k] = 1.0;
-            t.inner[k] = texel.w;
-            t.inner_odd[k] = 0.0;
-            t.inner_b[k] = 1.0 - texel.z;
-        }
+    if (CENTRED && CHANNELS) {
+        t.outer_odd = textureGather(odd_smoothies, corner, 0);
+        vec4 limit = textureGather(odd_smoothies, corner, 1);
+        // The channel in the alpha's lowest bit (centred.frag's with_channel).
+        uvec4 coded = uvec4(round(t.inner * 65535.0));
+        t.inner_odd = vec4(coded & 1u);
+        // Beyond its limit (centred.glsl) the receiver may not see past the edge: umbra.
+        t.inner = mix(vec4(coded >> 1u) / 32767.0, vec4(1.0), greaterThan(vec4(code), limit + LIMIT_SLACK));
     }
     t.behind = vec4(greaterThan(vec4(code), t.b));
     return t;
@@ -171,7 +165,7 @@ bool near_smoothie(vec2 uv, float umbra) {
         // An outer smoothie is written only with α' < 1 (centred.glsl), so its depth tells;
         // an inner alpha of 1 reads 65534 or 65535 with its channel bit, else 65535.
         vec4 b = textureGather(smoothies, corner, 0);
-        vec4 inner = textureGather(smoothies, corner, 3);
+        vec4 inner = textureGather(inner_smoothies, corner, 1);
         float umbra_alpha = CHANNELS ? 65533.5 / 65535.0 : 1.0;
         return edge || any(lessThan(b, vec4(1.0))) || any(lessThan(inner, vec4(umbra_alpha)));
     }

@@ -41,8 +41,22 @@ float smoothie_t(float depth) {
     return PHYSICAL_SIZE ? params.size.x / (depth + params.light.x) : params.size.x;
 }
 
-float reach(float depth) {
-    return clamp(1.0 - depth / params.size.z, 0.0, 1.0);
+// The farthest a receiver can lie behind the hull of q (src/geometry/smoothie.rs's
+// ReceiverBound::far_over).
+float far_over(vec2 q[4]) {
+    float far = params.size.z;
+    if (params.ground.w == 0.0) {
+        return far;
+    }
+    float nearest = 3.0e38;
+    for (int k = 0; k < 4; k++) {
+        nearest = min(nearest, dot(params.ground.xyz, vec3(q[k], 1.0)));
+    }
+    return nearest > 0.0 ? min(far, 1.001 / nearest) : far;
+}
+
+float reach(float depth, float far) {
+    return clamp(1.0 - depth / far, 0.0, 1.0);
 }
 
 // Inner quads' extra data: each vertex's point on the edge, the edge's outward normal, the
@@ -148,7 +162,9 @@ void wedge(vec2 p, float z, float t, vec2 n0, vec2 n1, vec2 m, float kk, Inner i
 // The corner at end k of silhouette s, given the vertex's end count and its other end.
 void corner(Silhouette s, int k, uint count, uint other) {
     vec2 p = s.t[k];
-    float z = s.z[k], t = smoothie_t(z), kk = reach(z);
+    float z = s.z[k], t = smoothie_t(z);
+    // The square of half-size t holds every kind of corner.
+    float kk = reach(z, far_over(vec2[4](p + t, p + vec2(t, -t), p - t, p + vec2(-t, t))));
     Silhouette o;
     if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
         vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
@@ -173,12 +189,18 @@ void corner(Silhouette s, int k, uint count, uint other) {
     corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
 }
 
+// The reach's receivers behind the uncut quad from edge ta–tb out by ta's and tb's t.
+float far_quad(vec2 ta, vec2 tb, float sa, float sb, vec2 out_dir) {
+    return far_over(vec2[4](ta, tb, ta + out_dir * sa, tb + out_dir * sb));
+}
+
 // The smoothie edge of the hard edge ta–tb (depths za, zb) out along `out_dir`, alpha 0 on the
 // edge and the reach k at t·k out, with projective weights 1/t (src/geometry/smoothie.rs's
 // SmoothieVertex::w).
 void edge_quad(vec2 ta, vec2 tb, float za, float zb, vec2 out_dir, Inner inner) {
-    float ka = reach(za), kb = reach(zb);
     float sa = smoothie_t(za), sb = smoothie_t(zb);
+    float far = far_quad(ta, tb, sa, sb, out_dir);
+    float ka = reach(za, far), kb = reach(zb, far);
     vec2 da = out_dir * sa * ka, db = out_dir * sb * kb;
     float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
     quad(vec2[4](ta, tb, tb + db, ta + da), float[4](za, zb, zb, za),
@@ -249,7 +271,8 @@ void partial_silhouette(uint i) {
         float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z);
         float beyond = dot(normal, pc.xy / pc.z) + smoothie_t(pc.z);
         float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - beyond;
-        if (gain <= params.light.w * max(sa * reach(pa.z), sb * reach(pb.z))) {
+        float far = far_quad(ta, tb, sa, sb, normal);
+        if (gain <= params.light.w * max(sa * reach(pa.z, far), sb * reach(pb.z, far))) {
             continue;
         }
         float behind = max(max(pa.z, pb.z), pc.z);

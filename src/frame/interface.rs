@@ -80,7 +80,10 @@ pub struct SilhouetteParams {
     /// centred smoothie buffer (`SmoothieVertex::channel`); z: centred, the light's radius
     /// (partial silhouettes), else 0; w: their `PARTIAL_GAIN`.
     pub light: Vec4,
-    pub pad: [Vec4; 9],
+    /// xyz: the ground's inverse light depth along the ray (x, y, 1), w: 1 where it bounds the
+    /// receivers (`geometry::smoothie::ReceiverBound`), else 0.
+    pub ground: Vec4,
+    pub pad: [Vec4; 8],
 }
 
 /// One caster's shadow volume from one light point, built on the GPU, padded to 256 bytes

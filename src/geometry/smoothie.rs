@@ -160,6 +160,37 @@ fn reach(b: f32, far: f32) -> f32 {
     (1.0 - b / far).clamp(0.0, 1.0)
 }
 
+/// What bounds the depth of the receivers behind a smoothie, for its [`reach`]: the farthest
+/// receiver in view, and the ground plane where every receiver lies on the light's side of it
+/// (then none lies beyond the plane along any ray). Under a caster near the ground the plane is
+/// much nearer than the farthest receiver: a plate at 1/8 of the light's height has
+/// 1 − b/r = 1/8 there, and its smoothies, cut at the plane, are an eighth as wide. The cut is
+/// exact for the outer halves, whose buffer alpha takes r no deeper than the plane
+/// (`glsl/smoothie/centred.glsl`): every fragment cut away was discarded there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReceiverBound {
+    pub far: f32,
+    /// The plane's inverse light depth along the view's ray (x/z, y/z, 1): 1/r = g · (x, y, 1)
+    /// where the ray meets it, at most 0 where it does not.
+    pub ground: Option<Vec3>,
+}
+
+impl ReceiverBound {
+    /// Receivers anywhere up to `far`.
+    pub fn up_to(far: f32) -> Self {
+        ReceiverBound { far, ground: None }
+    }
+
+    /// The farthest a receiver can lie behind any point of the convex hull of `region`
+    /// (tangent points): the inverse depth of a plane is affine in them, least at a corner.
+    fn far_over(&self, region: impl IntoIterator<Item = Vec2>) -> f32 {
+        let Some(g) = self.ground else { return self.far };
+        let nearest = region.into_iter().map(|p| g.dot(p.extend(1.0))).fold(f32::INFINITY, f32::min);
+        // A thousandth deeper, as the fit's far: rounding must not cut a receiver's smoothie.
+        if nearest > 0.0 { self.far.min(1.001 / nearest) } else { self.far }
+    }
+}
+
 fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
     SmoothieVertex {
         x: p.x,
@@ -209,7 +240,7 @@ pub fn merged_silhouette(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[PenumbraEdge],
-    (size, far): (SmoothieSize, f32),
+    (size, receivers): (SmoothieSize, ReceiverBound),
     tolerance: f32,
 ) -> Vec<MergedEdge> {
     let at = |i: u32| view.transform_point3(caster.positions[i as usize]);
@@ -218,6 +249,7 @@ pub fn merged_silhouette(
         (p.z > MIN_DEPTH).then(|| Vec2::new(p.x, p.y) / p.z)
     };
     let width = |i: u32| {
+        let far = project(i).map_or(receivers.far, |p| receivers.far_over([p]));
         let z = at(i).z;
         size.at(z) * reach(z, far)
     };
@@ -241,7 +273,7 @@ pub fn smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[PenumbraEdge],
-    size: (SmoothieSize, f32),
+    size: (SmoothieSize, ReceiverBound),
     penumbra: Penumbra,
 ) -> SmoothieGeometry {
     merged_smoothies(view, caster, &edges.iter().copied().map(MergedEdge::single).collect::<Vec<_>>(), size, penumbra)
@@ -255,7 +287,7 @@ pub fn merged_smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[MergedEdge],
-    (size, far): (SmoothieSize, f32),
+    (size, receivers): (SmoothieSize, ReceiverBound),
     penumbra: Penumbra,
 ) -> SmoothieGeometry {
     let project = |i: u32| {
@@ -275,17 +307,23 @@ pub fn merged_smoothies(
         ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
         ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
         let Some(normal) = normal else { continue };
-        // Per end: its point, depth, reach and size; the rim lies t · k out, alpha k there.
-        let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
-        let [a, b] = ends.map(|(p, z, k, t)| {
-            let p = p - normal * inside;
+        // Per end: its point, depth and size; the rim lies t · k out, alpha k there, k the
+        // reach over the whole quad's receivers (both ends', so the cut is linear in b).
+        let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, size.at(z)));
+        let far_over = |offset: f32, side: Vec2| {
+            receivers.far_over(ends.iter().flat_map(|&(p, _, t)| [p + side * offset, p + side * (offset + t)]))
+        };
+        let far = far_over(-inside, normal);
+        let [a, b] = ends.map(|(p, z, t)| {
+            let (p, k) = (p - normal * inside, reach(z, far));
             [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)].map(|v| weighted(v, t))
         });
         quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
-        if let Penumbra::Centred { near, far } = penumbra {
-            let range = (near, far);
-            let [a, b] = ends.map(|(p, z, k, t)| {
-                let p = p + normal * outside;
+        if let Penumbra::Centred { near, far: deepest } = penumbra {
+            let range = (near, deepest);
+            let far = far_over(-outside, -normal);
+            let [a, b] = ends.map(|(p, z, t)| {
+                let (p, k) = (p + normal * outside, reach(z, far));
                 let foot = (p, normal);
                 [inner_vertex(p, z, 0.0, foot, range), inner_vertex(p - normal * t * k, z, k, foot, range)]
                     .map(|v| weighted(v, t))
@@ -295,7 +333,7 @@ pub fn merged_smoothies(
     }
     ends.sort_unstable_by_key(|e| e.vertex);
     for group in ends.chunk_by(|x, y| x.vertex == y.vertex) {
-        corner(&mut out, group, (size, far), penumbra);
+        corner(&mut out, group, (size, receivers), penumbra);
     }
     out
 }
@@ -318,7 +356,7 @@ pub fn partial_smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[PartialEdge],
-    (size, far): (SmoothieSize, f32),
+    (size, receivers): (SmoothieSize, ReceiverBound),
 ) -> SmoothieGeometry {
     let project = |i: u32| {
         let p = view.transform_point3(caster.positions[i as usize]);
@@ -335,6 +373,7 @@ pub fn partial_smoothies(
         };
         // Outward: away from the face that faces the light's part they bound.
         let normal = if along.perp().dot(inside - pa) > 0.0 { -along.perp() } else { along.perp() };
+        let far = receivers.far_over([(pa, za), (pb, zb)].into_iter().flat_map(|(p, z)| [p, p + normal * size.at(z)]));
         let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
         let extent = |p: Vec2, z: f32| normal.dot(p) + size.at(z);
         let half = ends.iter().map(|(_, _, k, t)| t * k).fold(0.0, f32::max);
@@ -371,9 +410,17 @@ pub fn partial_smoothies(
 /// edge-on edge, normals on opposite sides, one or three or more edges) gets the full square
 /// of half-size t, which covers every direction outside: the §3 special case (averaging
 /// normals) is never needed, and minimum blending keeps the overlap with the edges continuous.
-fn corner(out: &mut SmoothieGeometry, group: &[End], (size, far): (SmoothieSize, f32), penumbra: Penumbra) {
+fn corner(
+    out: &mut SmoothieGeometry,
+    group: &[End],
+    (size, receivers): (SmoothieSize, ReceiverBound),
+    penumbra: Penumbra,
+) {
     let End { p, z, .. } = group[0];
-    let (t, k) = (size.at(z), reach(z, far));
+    let t = size.at(z);
+    // The square of half-size t holds every kind of corner.
+    let square = [Vec2::ONE, Vec2::new(1.0, -1.0), Vec2::NEG_ONE, Vec2::new(-1.0, 1.0)];
+    let k = reach(z, receivers.far_over(square.map(|c| p + c * t)));
     let at = |offset: Vec2| vertex(p + offset * t, z, offset);
     if let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group {
         // Both normals on the same side of the path through the vertex (in along -d1, out along
@@ -443,7 +490,7 @@ mod tests {
             let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
             let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
             prop_assert_eq!(edges.len(), 4, "a plate under the light: its outline");
-            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), Penumbra::Outer);
+            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), ReceiverBound::up_to(f32::INFINITY)), Penumbra::Outer);
             prop_assert!(g.inner.is_empty(), "outer only: no inner quads");
             prop_assert_eq!(g.edges.len(), 4 * 6);
             prop_assert_eq!(g.corners.len(), 4 * 12, "a wedge of two quads at each convex vertex");
@@ -477,6 +524,56 @@ mod tests {
         }
     }
 
+    proptest! {
+        /// A ground plane under the plate, level or tilted (its inverse depth along the ray
+        /// (x, y, 1) is g · (x, y, 1)): every smoothie's rim lies where a receiver on it, or in
+        /// front of it, already has α' = α / (1 − b/r) ≥ 1, so nothing cut away could darken one;
+        /// and the rim lies well inside the cut the farthest receiver alone allows.
+        #[test]
+        fn the_ground_cuts_smoothies_where_every_receiver_behind_is_lit(
+            height in 0.3f32..5.0,
+            t in 0.01f32..0.2,
+            tilt in -0.3f32..0.3,
+        ) {
+            let (positions, triangles, adjacency) = plate(height);
+            let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
+            let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
+            // The level ground lies at depth 10 below the light; tilted, nearer on one side.
+            let ground = Vec3::new(tilt * 0.1, 0.0, 0.1);
+            let far = 100.0;
+            let bound = ReceiverBound { far, ground: Some(ground) };
+            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), bound), CENTRED);
+            let uncut = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), ReceiverBound::up_to(far)), CENTRED);
+            prop_assert_eq!(g.vertices().count(), uncut.vertices().count(), "the same smoothies, cut shorter");
+            let mut widest = 0.0f32;
+            for v in g.vertices().filter(|v| v.sx != 0.0 || v.sy != 0.0) {
+                let alpha = Vec2::new(v.sx, v.sy).length();
+                let lit_from = 1.0 - v.b * ground.dot(Vec3::new(v.x, v.y, 1.0));
+                prop_assert!(alpha >= lit_from - 1e-4, "rim alpha {alpha} short of {lit_from} at ({}, {})", v.x, v.y);
+                widest = widest.max(alpha);
+            }
+            let far_cut = 1.0 - (10.0 - height) / far;
+            // The ground 10 deep, the far receiver 100: 1 − b/10 against 1 − b/100.
+            prop_assert!(widest < far_cut - 0.3, "rim alpha up to {widest}, the far receiver's cut {far_cut}");
+        }
+    }
+
+    #[test]
+    fn without_a_ground_under_them_smoothies_reach_the_farthest_receiver() {
+        let (positions, triangles, adjacency) = plate(1.0);
+        let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
+        let edges =
+            silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
+        let size = SmoothieSize::Fixed(0.1);
+        let far = ReceiverBound::up_to(20.0);
+        // A plane the rays climb away from (inverse depth ≤ 0: never met) bounds nothing.
+        let away = ReceiverBound { ground: Some(Vec3::new(0.0, 0.0, -0.1)), ..far };
+        assert_eq!(
+            smoothies(&down(), &caster, &edges, (size, away), CENTRED),
+            smoothies(&down(), &caster, &edges, (size, far), CENTRED)
+        );
+    }
+
     fn inside(tri: &[SmoothieVertex], q: Vec2) -> bool {
         let [a, b, c] = [0, 1, 2].map(|i| Vec2::new(tri[i].x, tri[i].y));
         let w = [(b - a).perp_dot(q - a), (c - b).perp_dot(q - b), (a - c).perp_dot(q - c)];
@@ -495,7 +592,7 @@ mod tests {
         let adjacency = EdgeAdjacency::default();
         let caster = Caster { positions: &positions, triangles: &[], adjacency: &adjacency };
         let mut edges: Vec<([u32; 2], u32)> = (0..6).map(|i| ([i, (i + 1) % 6], 6)).collect();
-        let size = (SmoothieSize::Fixed(0.05), f32::INFINITY);
+        let size = (SmoothieSize::Fixed(0.05), ReceiverBound::up_to(f32::INFINITY));
         let corners = |edges: &[([u32; 2], u32)]| {
             let g = smoothies(&Mat4::IDENTITY, &caster, edges, size, Penumbra::Outer);
             let mut at: Vec<(i32, i32, usize)> = Vec::new();
@@ -535,8 +632,13 @@ mod tests {
                 let caster = Caster { positions: &positions, triangles: &[], adjacency: &adjacency };
                 let edges = [([0, 1], 3), ([1, 2], 3)];
                 for penumbra in [Penumbra::Outer, CENTRED] {
-                    let g =
-                        smoothies(&Mat4::IDENTITY, &caster, &edges, (SmoothieSize::Fixed(t), f32::INFINITY), penumbra);
+                    let g = smoothies(
+                        &Mat4::IDENTITY,
+                        &caster,
+                        &edges,
+                        (SmoothieSize::Fixed(t), ReceiverBound::up_to(f32::INFINITY)),
+                        penumbra,
+                    );
                     let near = |tri: &&[SmoothieVertex]| tri.iter().all(|v| Vec2::new(v.x, v.y).length() < 2.0 * t);
                     let area = |triangles: &[SmoothieVertex]| -> f32 {
                         let area = |tri: &[SmoothieVertex]| {
@@ -575,7 +677,7 @@ mod tests {
             let (positions, triangles, adjacency) = plate(height);
             let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
             let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
-            let size = (SmoothieSize::Fixed(t), f32::INFINITY);
+            let size = (SmoothieSize::Fixed(t), ReceiverBound::up_to(f32::INFINITY));
             let g = smoothies(&down(), &caster, &edges, size, CENTRED);
             prop_assert_eq!(g.inner.len(), 4 * 6, "one inner quad per silhouette edge");
             prop_assert_eq!(g.corners.len(), 4 * 12, "a wedge at each convex vertex, nothing over the blocker");
@@ -613,7 +715,13 @@ mod tests {
         let caster = Caster { positions: &positions, triangles: &triangles, adjacency: &adjacency };
         let edges =
             silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
-        let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(0.1), f32::INFINITY), CENTRED);
+        let g = smoothies(
+            &down(),
+            &caster,
+            &edges,
+            (SmoothieSize::Fixed(0.1), ReceiverBound::up_to(f32::INFINITY)),
+            CENTRED,
+        );
         assert!(g.is_empty());
     }
 }

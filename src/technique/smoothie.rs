@@ -82,12 +82,12 @@ use super::smoothie_gpu::GpuSilhouettes;
 use super::{Technique, clear_visibility, surface_inputs};
 use crate::error::Result;
 use crate::frame::FrameInputs;
-use crate::geometry::Aabb;
 use crate::geometry::silhouette::{Caster, EdgeSource, PartialEdge, partial_silhouettes, penumbra_edges};
 use crate::geometry::smoothie::{
-    Penumbra, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette, merged_smoothies,
-    partial_smoothies, smoothies,
+    Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette,
+    merged_smoothies, partial_smoothies, smoothies,
 };
+use crate::geometry::{Aabb, LightFrustum};
 use crate::gpu::{
     Access, Attachment, Blend, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
     Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices, ensure, shaders,
@@ -235,11 +235,12 @@ enum Buffer {
     /// The paper's: depth b (as a code in [0, 1], glsl/smoothie/depth.glsl) and remapped alpha
     /// α' (glsl/smoothie/smoothie.frag).
     Outer,
-    /// Centred, one caster: b, α', the inner quads' 1 − b and α (glsl/smoothie/centred_one.frag).
+    /// Centred, one caster: b, α', and in a second target the inner quads' 1 − b and α
+    /// (glsl/smoothie/centred_one.frag).
     Centred,
-    /// Centred, several casters: b, α' of the even and of the odd casters, the inner quads' α
-    /// (with their channel), and in a second target their 1 − b and their limit
-    /// (glsl/smoothie/centred.frag).
+    /// Centred, several casters: as one caster's, the even casters' α' in the first target and
+    /// the inner α with its caster's channel in the second, and a third, the odd casters' α'
+    /// and the inner quads' limit (glsl/smoothie/centred.frag).
     Channels,
 }
 
@@ -266,17 +267,21 @@ impl Buffer {
         }
     }
 
-    /// Its targets' formats, minimum-blended: unsigned normalized 16-bit channels where the
-    /// device blends into them (Vulkan does not require it), else 32-bit floats holding the
-    /// same codes.
+    /// Its targets' formats, minimum-blended, two channels each (centred.frag says why):
+    /// unsigned normalized 16-bit channels where the device blends into them (Vulkan does not
+    /// require it), else 32-bit floats holding the same codes.
     fn formats(self, ctx: &Context) -> Vec<vk::Format> {
-        let pick = |unorm, float| if ctx.renders_blended(unorm) { unorm } else { float };
-        let rgba = pick(vk::Format::R16G16B16A16_UNORM, vk::Format::R32G32B32A32_SFLOAT);
-        match self {
-            Buffer::Outer => vec![pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)],
-            Buffer::Centred => vec![rgba],
-            Buffer::Channels => vec![rgba, pick(vk::Format::R16G16_UNORM, vk::Format::R32G32_SFLOAT)],
-        }
+        let rg = if ctx.renders_blended(vk::Format::R16G16_UNORM) {
+            vk::Format::R16G16_UNORM
+        } else {
+            vk::Format::R32G32_SFLOAT
+        };
+        let targets = match self {
+            Buffer::Outer => 1,
+            Buffer::Centred => 2,
+            Buffer::Channels => 3,
+        };
+        vec![rg; targets]
     }
 }
 
@@ -393,8 +398,8 @@ pub struct Smoothie {
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
     vertices: Option<PerFrame>,
-    /// The smoothie buffer and, centred with several casters, the inner quads' depths.
-    buffer: [Option<Target>; 2],
+    /// The smoothie buffer's targets, as many as its layout has ([`Buffer::formats`]).
+    buffer: [Option<Target>; 3],
     silhouettes: Vec<Option<CasterSilhouette>>,
     /// The meshes the shadow map draws: the smoothies' own (`shadow_mesh_error`).
     casters: CasterMeshes,
@@ -413,7 +418,7 @@ impl Smoothie {
             resolve: MaskedResolve::default(),
             visibility,
             vertices: None,
-            buffer: [None, None],
+            buffer: [None, None, None],
             silhouettes: Vec::new(),
             casters: CasterMeshes::default(),
             gpu: None,
@@ -427,7 +432,7 @@ impl Smoothie {
         frame: &FrameInputs<'_>,
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
-        (size, far): (SmoothieSize, f32),
+        (size, receivers): (SmoothieSize, ReceiverBound),
         (centred, tolerance): (bool, f32),
     ) -> SmoothieGeometry {
         let objects = &frame.scene.objects;
@@ -462,12 +467,12 @@ impl Smoothie {
             let view = *view * model;
             let penumbra = penumbra(centred, &view, &o.mesh.bounds);
             let mut geometry = if tolerance > 0.0 {
-                let merged = merged_silhouette(&view, &caster, &c.edges, (size, far), tolerance);
-                merged_smoothies(&view, &caster, &merged, (size, far), penumbra)
+                let merged = merged_silhouette(&view, &caster, &c.edges, (size, receivers), tolerance);
+                merged_smoothies(&view, &caster, &merged, (size, receivers), penumbra)
             } else {
-                smoothies(&view, &caster, &c.edges, (size, far), penumbra)
+                smoothies(&view, &caster, &c.edges, (size, receivers), penumbra)
             };
-            geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, far)));
+            geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, receivers)));
             out.extend(&geometry.in_channel(number));
         }
         out
@@ -527,6 +532,7 @@ impl Technique for Smoothie {
         self.pass.record(frame, &frustum, size, biases, kernel, Some(&self.casters))?;
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
+        let receivers = receiver_bound(frame, &frustum);
         let source = if params.is_on(&GPU_SILHOUETTES) {
             if self.gpu.is_none() {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
@@ -534,14 +540,13 @@ impl Technique for Smoothie {
             let gpu = self.gpu.as_mut().expect("made above");
             let radius = frame.scene.light.radius;
             let (vertices, args) =
-                gpu.record(frame, &cast, &frustum.view, (smoothie_size, frustum.far), (centred, radius))?;
+                gpu.record(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, radius))?;
             Smoothies::Indirect { vertices, args }
         } else {
             // The merge bound in tangent units: texels of the smoothie buffer over the window.
             let [x0, y0, x1, y1] = frustum.window;
             let tolerance = params.get(&MERGE) as f32 * (x1 - x0).max(y1 - y0) / buffer_size as f32;
-            let geometry =
-                self.geometry(frame, &cast, &frustum.view, (smoothie_size, frustum.far), (centred, tolerance));
+            let geometry = self.geometry(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, tolerance));
             let vertices: Vec<SmoothieVertex> = geometry.vertices().copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
             if bytes.is_empty() {
@@ -556,7 +561,9 @@ impl Technique for Smoothie {
 
         let layout = Buffer::new(centred, cast.iter().flatten().count());
         let formats = &self.buffer_formats[layout as usize];
-        for ((target, &format), name) in self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner depths"]) {
+        for ((target, &format), name) in
+            self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner smoothies", "odd smoothies"])
+        {
             ensure(ctx, target, TargetDesc::color(name, format, buffer_size, buffer_size))?;
         }
         let smoothie = self.smoothie.get(layout, |&layout| {
@@ -588,14 +595,14 @@ impl Technique for Smoothie {
 
         let mut reads: Vec<_> = targets.iter_mut().flatten().map(|t| (t, Access::FRAGMENT_READ, false)).collect();
         transition(ctx, cmd, &mut reads);
-        let buffer = self.buffer[0].as_ref().expect("ensured");
-        // Without a target of inner depths the resolve reads none: the buffer stands in.
-        let inner = self.buffer[1].as_ref().filter(|_| layout == Buffer::Channels).unwrap_or(buffer);
-        let inputs = [
-            &surface_inputs(frame, light)[..],
-            &[Descriptor::Image(map), Descriptor::Image(buffer), Descriptor::Image(inner)],
-        ]
-        .concat();
+        // The resolve reads only the buffer's targets of this layout; the first stands in for
+        // the others.
+        let [outer, inner, odd] = [0, 1, 2].map(|i| self.buffer[i].as_ref().filter(|_| i < formats.len()));
+        let outer = outer.expect("ensured");
+        let [inner, odd] = [inner, odd].map(|t| Descriptor::Image(t.unwrap_or(outer)));
+        let inputs =
+            [&surface_inputs(frame, light)[..], &[Descriptor::Image(map), Descriptor::Image(outer), inner, odd]]
+                .concat();
         // One frustum for both: equal sizes put the buffer's texels on the map's.
         let key = (params.get(&SMOOTHIE_FALLOFF) as u32, layout, buffer_size == size);
         self.resolve.record(frame, self.visibility, key, visibility, &inputs)
@@ -611,6 +618,22 @@ impl Technique for Smoothie {
         this.casters.destroy(ctx);
         this.gpu.into_iter().for_each(|g| g.destroy(ctx));
     }
+}
+
+/// What bounds the receivers' depths behind the smoothies of `frustum` ([`ReceiverBound`]): the
+/// ground plane too where the light and every receiver in view lie above it.
+fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBound {
+    let far = ReceiverBound::up_to(frustum.far);
+    let Some(ground) = frame.scene.ground else { return far };
+    let height = frustum.centre().y - ground.height;
+    // A receiver's bounds may touch the plane from below by rounding.
+    let above = |p: &Vec3| p.y >= ground.height - 1e-4 * height;
+    if height <= 0.0 || !frame.receivers_in_view.iter().all(above) {
+        return far;
+    }
+    // 1/r along the ray (x/z, y/z, 1): its world y per unit depth (the view's rows are the
+    // light's axes; glsl/smoothie/depth.glsl's ground_depth) over the plane's, −height.
+    ReceiverBound { ground: Some(frustum.view.y_axis.truncate() / -height), ..far }
 }
 
 /// The smoothies' side for a caster within `bounds` seen through `view`.

@@ -18,7 +18,7 @@ use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::silhouette::PARTIAL_GAIN;
-use crate::geometry::smoothie::{Penumbra, SmoothieSize};
+use crate::geometry::smoothie::{Penumbra, ReceiverBound, SmoothieSize};
 use crate::gpu::{
     Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
     buffer_barrier, dispatch, shaders, update_buffer, upload,
@@ -95,6 +95,7 @@ pub struct GpuSilhouettes {
 struct OutputKey {
     casters: Vec<(MeshId, Mat4)>,
     size: [f32; 4],
+    ground: Vec4,
     centred: bool,
     /// The light's radius, centred (partial silhouettes); 0 outer only.
     partial_radius: f32,
@@ -126,7 +127,7 @@ impl GpuSilhouettes {
         frame: &mut FrameInputs<'_>,
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
-        (size, far): (SmoothieSize, f32),
+        (size, receivers): (SmoothieSize, ReceiverBound),
         (centred, light_radius): (bool, f32),
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
@@ -171,9 +172,12 @@ impl GpuSilhouettes {
         // barriers below order this frame's writes after their reads).
         let (vertices, args) = (self.vertices.as_ref().expect("ensured").range(0), self.args.range(0));
         let args = vk::DescriptorBufferInfo { range: 16, ..args };
+        let far = receivers.far;
+        let ground = receivers.ground.map_or(Vec4::ZERO, |g| g.extend(1.0));
         let key = OutputKey {
             casters: casters.iter().map(|o| (o.mesh.id(), *view * o.transform.matrix())).collect(),
             size: [scale, f32::from(u8::from(physical)), far, behind],
+            ground,
             centred,
             partial_radius,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
@@ -195,7 +199,8 @@ impl GpuSilhouettes {
                 size: Vec4::new(scale, near, far, caster_far),
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
                 light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
-                pad: [Vec4::ZERO; 9],
+                ground,
+                pad: [Vec4::ZERO; 8],
             });
         }
         let params_buffer = self.params.as_mut().expect("ensured");
