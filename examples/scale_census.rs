@@ -105,7 +105,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fit_spot_frustum(light, scene.light.target, &[bounds], &receivers).frustum.ok_or("not in view")?;
         let behind = frustum.view.transform_point3(light).length();
         let size = SmoothieSize::Physical { light_radius: scene.light.radius, scale: 1.0, behind };
-        let frustum = frustum.grown(size.largest_reach(frustum.near, frustum.far));
+        let frustum =
+            frustum.grown(size.largest_reach(frustum.near, frustum.window, ReceiverBound::up_to(frustum.far)));
         let started = Instant::now();
         let (near, far) = depth_range(&frustum.view, &bounds);
         let penumbra = smoothie::Penumbra::Centred { near, far };

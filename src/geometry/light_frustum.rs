@@ -262,6 +262,13 @@ impl LightFrustum {
         self.view.inverse().transform_point3(Vec3::ZERO)
     }
 
+    /// The tangent window (x/z, y/z) of a box seen through this view; unbounded if part of it
+    /// lies at or behind the light.
+    pub fn window_of(&self, bounds: &Aabb) -> [f32; 4] {
+        let view = self.view.as_dmat4();
+        tangent_window(bounds.corners().into_iter().map(|c| view.transform_point3(c.as_dvec3()))).map(|v| v as f32)
+    }
+
     /// `LightView::depths`: near, far, log2(far / near), 0.
     pub fn depths(&self) -> Vec4 {
         Vec4::new(self.near, self.far, (self.far / self.near).log2(), 0.0)

@@ -103,9 +103,19 @@ pub enum SmoothieSize {
 }
 
 impl SmoothieSize {
-    /// How far any smoothie between `near` and `far` reaches (see [`smoothies`]).
-    pub fn largest_reach(self, near: f32, far: f32) -> f32 {
-        self.at(near) * reach(near, far)
+    /// How far beyond its outline any smoothie of a caster reaches whose outline lies within
+    /// `window` (tangent units) and whose nearest depth is `near`: t there (the largest), cut
+    /// as [`smoothies`] cuts it, for the receivers behind all it could cover.
+    pub fn largest_reach(self, near: f32, window: [f32; 4], receivers: ReceiverBound) -> f32 {
+        let t = self.at(near);
+        let [x0, y0, x1, y1] = window;
+        let covered = [
+            Vec2::new(x0 - t, y0 - t),
+            Vec2::new(x1 + t, y0 - t),
+            Vec2::new(x1 + t, y1 + t),
+            Vec2::new(x0 - t, y1 + t),
+        ];
+        t * reach(near, receivers.far_over(covered))
     }
 
     fn at(self, depth: f32) -> f32 {
