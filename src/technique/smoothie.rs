@@ -109,6 +109,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
         DEPTH16,
         GPU_SILHOUETTES,
         MERGE,
+        PENUMBRA_TEXELS,
         SOFT_SHADOW_MESH_ERROR,
     ],
     create: |ctx, _, visibility| Ok(Box::new(Smoothie::new(ctx, visibility)?)),
@@ -137,16 +138,17 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// cost goals.
 pub const OUTER_ONLY: Setting = &[("penumbra", "0"), ("falloff", "0")];
 
-/// The map and the smoothie buffer at half the default width: a quarter of their texels, for
-/// bench's row of the trade.
-const QUARTER_TEXELS: Setting = &[("shadow_map_size", "512"), ("smoothie_size", "512")];
+/// The map and the smoothie buffer at half the default width whatever the penumbrae: a quarter
+/// of their texels, for bench's row of the trade.
+const QUARTER_TEXELS: Setting = &[("shadow_map_size", "512"), ("smoothie_size", "512"), ("penumbra_texels", "0")];
 
 /// The paper's map is smaller than the hard shadow map's default. At half of it with a buffer
 /// to match ([`QUARTER_TEXELS`]; bench, 512², lavapipe, one run) the frame cost 0.65–0.91× the
 /// default's and the penumbra RMSE stayed within 0.0007 on seven suite scenes, but where
 /// penumbrae are a few texels wide it broke: the wingnut near contact 0.018 → 0.050 with 341
 /// leaking pixels where there were none, `default` 0.057 → 0.063 and leaks 155 → 493, the torus
-/// 0.0089 → 0.0107.
+/// 0.0089 → 0.0107: hence [`PENUMBRA_TEXELS`], which halves them only where the smoothies are
+/// wide. Both sizes are the largest the map and buffer get.
 const MAP_SIZE: Knob = Knob { default: 1024.0, ..SHADOW_MAP_SIZE };
 const SMOOTHIE_SIZE: Knob = Knob {
     name: "smoothie_size",
@@ -154,7 +156,7 @@ const SMOOTHIE_SIZE: Knob = Knob {
     min: 16.0,
     max: 16384.0,
     integer: true,
-    help: "smoothie buffer width and height, in texels",
+    help: "smoothie buffer width and height, in texels (the largest: see penumbra_texels)",
 };
 const T: Knob = Knob {
     name: "t",
@@ -214,6 +216,28 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// run) the buffer pass takes 0.4–0.9× its unmerged time on the suite and the scale scenes, but
 /// the wingnut's penumbra, a few texels wide near contact, goes from RMSE 0.018 to 0.189: a
 /// bound in texels is too loose where the penumbra is narrow.
+/// Map and buffer sized to the narrowest smoothie: where every caster's smoothies span many
+/// texels, a coarser grid resolves them as well (see [`halvings`]). At 10 (bench's scenes at
+/// 512², lavapipe, against the reference with samples=256 and against 0, interleaved runs):
+/// contact, open_mesh, overlap, plate and sphere get half the size, low_light a quarter, the
+/// rest keep it (the wingnut, the box on the ground, the torus, the default scene's small casters
+/// near the ground); the penumbra RMSE of each moved by at most 0.0003 (contact 0.0351 →
+/// 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 → 0.0152), the frame 0.63–0.90× (low_light
+/// 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 → 32.5).
+const PENUMBRA_TEXELS: Knob = Knob {
+    name: "penumbra_texels",
+    default: 10.0,
+    min: 0.0,
+    max: 1024.0,
+    integer: false,
+    help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
+};
+/// The most [`halvings`] take off the map and buffer sizes, and the least size they leave.
+const MAX_HALVINGS: u32 = 2;
+const MIN_HALVED_SIZE: u32 = 128;
+/// How many times [`PENUMBRA_TEXELS`] a frame's narrowest smoothie must span to take a coarser
+/// grid than the frame before ([`halvings`]).
+const HALVING_MARGIN: f32 = 1.25;
 const MERGE: Knob = Knob {
     name: "merge",
     default: 0.0,
@@ -407,6 +431,9 @@ pub struct Smoothie {
     casters: CasterMeshes,
     /// The compute path, made when first asked for.
     gpu: Option<GpuSilhouettes>,
+    /// The last frame's [`halvings`] with the knobs they came from (texels, largest size),
+    /// which the next frame keeps within their margin if those are the same.
+    halved: Option<(f32, u32, u32)>,
 }
 
 impl Smoothie {
@@ -424,6 +451,7 @@ impl Smoothie {
             silhouettes: Vec::new(),
             casters: CasterMeshes::default(),
             gpu: None,
+            halved: None,
         })
     }
 
@@ -514,8 +542,19 @@ impl Technique for Smoothie {
             let old = std::mem::replace(&mut self.pass, ShadowMapPass::new(ctx, format)?);
             ctx.retire(move |ctx| old.destroy(ctx));
         }
-        let size = params.get(&MAP_SIZE) as u32;
-        let buffer_size = params.get(&SMOOTHIE_SIZE) as u32;
+        let [x0, y0, x1, y1] = frustum.window;
+        let window = (x1 - x0).max(y1 - y0);
+        let narrowest = narrowest_smoothie(&self.casters.bounds(), &frustum, smoothie_size, receivers);
+        // The outer-only form's penumbra begins at the map's hard edge, which a coarser grid
+        // moves by its texel: a box's outline 0.5 mm off moved V by up to 0.063 at 512² against
+        // 2/255 at 1024² (tests/smoothie.rs, a_finely_tessellated_outline_casts_*).
+        let texels = if centred { params.get(&PENUMBRA_TEXELS) as f32 } else { 0.0 };
+        let (size, buffer_size) = (params.get(&MAP_SIZE) as u32, params.get(&SMOOTHIE_SIZE) as u32);
+        let finest = size.min(buffer_size);
+        let previous = self.halved.filter(|&(t, f, _)| (t, f) == (texels, finest)).map(|(_, _, h)| h);
+        let halved = halvings(narrowest / window * finest as f32, finest, texels, previous);
+        self.halved = Some((texels, finest, halved));
+        let (size, buffer_size) = (size >> halved, buffer_size >> halved);
         // The ground's height (none: infinitely far below) and the light view origin's, for r in
         // pass 2.
         let ground = frame.scene.ground.map_or(-f32::MAX, |g| g.height);
@@ -562,8 +601,7 @@ impl Technique for Smoothie {
             }
         };
 
-        let [x0, y0, x1, y1] = frustum.window;
-        let texel = (x1 - x0).max(y1 - y0) / buffer_size as f32;
+        let texel = window / buffer_size as f32;
         let layout =
             Buffer::new(centred, casters_meet(&self.casters.bounds(), &frustum, smoothie_size, receivers, texel));
         let formats = &self.buffer_formats[layout as usize];
@@ -671,6 +709,44 @@ fn casters_meet(
     windows.iter().enumerate().any(|(i, a)| windows[i + 1..].iter().any(|b| meet(a, b)))
 }
 
+/// An estimate of the narrowest smoothie of casters within `bounds`, in tangent units: each
+/// caster's at its deepest point, where t = R/b is least and so is the part 1 − b/r its
+/// receivers can need of it (as [`smoothies`] cuts it); the least of them. Its receivers' own
+/// penumbrae are narrower still where they lie in front of the ground (a caster on another):
+/// those receivers then get the coarser grid.
+fn narrowest_smoothie(bounds: &[Aabb], frustum: &LightFrustum, size: SmoothieSize, receivers: ReceiverBound) -> f32 {
+    bounds
+        .iter()
+        .map(|b| {
+            let (_, deepest) = depth_range(&frustum.view, b);
+            size.largest_reach(deepest, frustum.window_of(b), receivers)
+        })
+        .fold(f32::INFINITY, f32::min)
+}
+
+/// How many times the map and buffer of `size` texels are halved: while the narrowest
+/// smoothie, `narrowest` texels of them wide, still spans `texels` texels of the halved grid,
+/// at most [`MAX_HALVINGS`] times and never below [`MIN_HALVED_SIZE`]; never with `texels` 0.
+/// Across a smoothie's width its alpha is linear, which the resolve's bilinear lookup holds
+/// exactly on any grid; what a grid's texel costs is where the map's hard edge lies, a texel
+/// of which moves V by about 1/`texels` of the penumbra.
+///
+/// A switch of grids moves V where the hard edge crosses texels, by up to 0.13 at a few pixels
+/// (sphere, contact: 3 and 73 of 262144 pixels by more than 0.02, a change a moving caster
+/// would show as a flicker), so after the `previous` frame's count a coarser grid needs
+/// [`HALVING_MARGIN`] times the texels, and the count it had is kept while it still fits.
+fn halvings(narrowest: f32, size: u32, texels: f32, previous: Option<u32>) -> u32 {
+    if texels <= 0.0 || !narrowest.is_finite() {
+        return 0;
+    }
+    let fits = |h: u32, margin: f32| narrowest / (1u32 << h) as f32 >= texels * margin && size >> h >= MIN_HALVED_SIZE;
+    let most = |up_to: u32, margin: f32| (1..=up_to).take_while(|&h| fits(h, margin)).last().unwrap_or(0);
+    match previous {
+        None => most(MAX_HALVINGS, 1.0),
+        Some(previous) => most(MAX_HALVINGS, HALVING_MARGIN).max(most(previous.min(MAX_HALVINGS), 1.0)),
+    }
+}
+
 /// The smoothies' side for a caster within `bounds` seen through `view`.
 pub(super) fn penumbra(centred: bool, view: &Mat4, bounds: &Aabb) -> Penumbra {
     if centred {
@@ -692,6 +768,34 @@ enum Smoothies {
 mod tests {
     use super::*;
     use crate::geometry::fit_spot_frustum;
+
+    proptest::proptest! {
+        /// Halved, the narrowest smoothie still spans `texels`; halved once more it would not
+        /// (after a frame with fewer halvings: not by the margin), or the grid would pass its
+        /// limits; fewer than the frame before only where that frame's no longer fit.
+        #[test]
+        fn grids_halve_while_the_narrowest_smoothie_spans_enough_texels(
+            narrowest in 0.0f32..2000.0,
+            size_log in 4u32..14,
+            texels in 0.0f32..64.0,
+            previous in proptest::option::of(0u32..4),
+        ) {
+            let size = 1 << size_log;
+            let h = halvings(narrowest, size, texels, previous);
+            let fits = |h: u32, margin: f32| narrowest / (1u32 << h) as f32 >= texels * margin && size >> h >= MIN_HALVED_SIZE;
+            proptest::prop_assert!(h <= MAX_HALVINGS);
+            proptest::prop_assert!(texels > 0.0 || h == 0);
+            proptest::prop_assert!(h == 0 || fits(h, 1.0), "{h} halvings do not fit");
+            if texels > 0.0 {
+                // Up to the frame before's count no margin is needed; beyond it, the margin.
+                let margin = if previous.is_none_or(|p| h < p) { 1.0 } else { HALVING_MARGIN };
+                proptest::prop_assert!(h == MAX_HALVINGS || !fits(h + 1, margin), "{h} halvings after {previous:?}, one more would do");
+                if let Some(p) = previous.filter(|&p| p < h) {
+                    proptest::prop_assert!(fits(h, HALVING_MARGIN), "{h} halvings after {p} without the margin");
+                }
+            }
+        }
+    }
 
     #[test]
     fn casters_get_channels_only_where_their_smoothies_can_meet() {
