@@ -683,9 +683,9 @@ fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBo
 /// Whether two casters' smoothies can meet in the buffer, or one's inner quads probe the other
 /// just outside its edge (glsl/smoothie/centred.glsl): only then do they need the channels of
 /// [`Buffer::Channels`]. Casters apart, one caster's buffer holds them all as well, a target
-/// fewer (overlap's two plates moved 3 m apart, 512², lavapipe, three interleaved runs: the
-/// smoothie pass 5.5–6.7 → 4.4–5.5 ms, the resolve 11.9–15.6 → 10.4–14.4, V the same within
-/// 1e-4). Each caster's window, grown by its smoothies' reach and two texels, against every
+/// fewer (overlap's two plates moved about 3 m further apart, 512², lavapipe, three interleaved
+/// runs: the smoothie pass 5.5–6.7 → 4.4–5.5 ms, the resolve 11.9–15.6 → 10.4–14.4, V the same
+/// within 1e-4). Each caster's window, grown by its smoothies' reach and two texels, against every
 /// other's: boxes, so a caster whose box reaches another's gets channels all the same.
 fn casters_meet(
     bounds: &[Aabb],
