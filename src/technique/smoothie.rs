@@ -518,7 +518,8 @@ impl Technique for Smoothie {
         let cast: Vec<Option<Arc<Mesh>>> =
             frame.scene.objects.iter().map(|o| o.casts.then(|| shadow_mesh(o, light, params))).collect();
         self.casters.prepare(frame, |i| cast.get(i).and_then(Option::as_ref))?;
-        let Some(frustum) = ShadowMapPass::fit_to(frame, &self.casters.bounds()) else {
+        let bounds = self.casters.bounds();
+        let Some(frustum) = ShadowMapPass::fit_to(frame, &bounds) else {
             return clear_visibility(frame, visibility);
         };
         let t = params.get(&T) as f32;
@@ -544,7 +545,8 @@ impl Technique for Smoothie {
         }
         let [x0, y0, x1, y1] = frustum.window;
         let window = (x1 - x0).max(y1 - y0);
-        let narrowest = narrowest_smoothie(&self.casters.bounds(), &frustum, smoothie_size, receivers);
+        let extents: Vec<CasterExtent> = bounds.iter().map(|b| CasterExtent::new(&frustum, b)).collect();
+        let narrowest = narrowest_smoothie(&extents, smoothie_size, receivers);
         // The outer-only form's penumbra begins at the map's hard edge, which a coarser grid
         // moves by its texel: a box's outline 0.5 mm off moved V by up to 0.063 at 512² against
         // 2/255 at 1024² (tests/smoothie.rs, a_finely_tessellated_outline_casts_*).
@@ -602,8 +604,7 @@ impl Technique for Smoothie {
         };
 
         let texel = window / buffer_size as f32;
-        let layout =
-            Buffer::new(centred, casters_meet(&self.casters.bounds(), &frustum, smoothie_size, receivers, texel));
+        let layout = Buffer::new(centred, casters_meet(&extents, smoothie_size, receivers, texel));
         let formats = &self.buffer_formats[layout as usize];
         for ((target, &format), name) in
             self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner smoothies", "odd smoothies"])
@@ -680,6 +681,21 @@ fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBo
     ReceiverBound { ground: Some(frustum.view.y_axis.truncate() / -height), ..far }
 }
 
+/// Where a caster's bounds lie in the light view: their tangent window and depth range, which
+/// [`casters_meet`] and [`narrowest_smoothie`] both take.
+struct CasterExtent {
+    window: [f32; 4],
+    near: f32,
+    deepest: f32,
+}
+
+impl CasterExtent {
+    fn new(frustum: &LightFrustum, bounds: &Aabb) -> Self {
+        let (near, deepest) = depth_range(&frustum.view, bounds);
+        CasterExtent { window: frustum.window_of(bounds), near, deepest }
+    }
+}
+
 /// Whether two casters' smoothies can meet in the buffer, or one's inner quads probe the other
 /// just outside its edge (glsl/smoothie/centred.glsl): only then do they need the channels of
 /// [`Buffer::Channels`]. Casters apart, one caster's buffer holds them all as well, a target
@@ -687,24 +703,16 @@ fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBo
 /// runs: the smoothie pass 5.5–6.7 → 4.4–5.5 ms, the resolve 11.9–15.6 → 10.4–14.4, V the same
 /// within 1e-4). Each caster's window, grown by its smoothies' reach and two texels, against every
 /// other's: boxes, so a caster whose box reaches another's gets channels all the same.
-fn casters_meet(
-    bounds: &[Aabb],
-    frustum: &LightFrustum,
-    size: SmoothieSize,
-    receivers: ReceiverBound,
-    texel: f32,
-) -> bool {
+fn casters_meet(casters: &[CasterExtent], size: SmoothieSize, receivers: ReceiverBound, texel: f32) -> bool {
     let everywhere = [f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY];
-    let covered = |b: &Aabb| {
-        let window = frustum.window_of(b);
-        let (near, _) = depth_range(&frustum.view, b);
+    let covered = |&CasterExtent { window, near, .. }: &CasterExtent| {
         let pad = size.largest_reach(near, window, receivers) + 2.0 * texel;
         let [x0, y0, x1, y1] = window;
         let grown = [x0 - pad, y0 - pad, x1 + pad, y1 + pad];
         // A caster reaching the light's plane covers everything.
         if grown.iter().all(|v| v.is_finite()) { grown } else { everywhere }
     };
-    let windows: Vec<[f32; 4]> = bounds.iter().map(covered).collect();
+    let windows: Vec<[f32; 4]> = casters.iter().map(covered).collect();
     let meet = |a: &[f32; 4], b: &[f32; 4]| a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
     windows.iter().enumerate().any(|(i, a)| windows[i + 1..].iter().any(|b| meet(a, b)))
 }
@@ -714,14 +722,8 @@ fn casters_meet(
 /// receivers can need of it (as [`smoothies`] cuts it); the least of them. Its receivers' own
 /// penumbrae are narrower still where they lie in front of the ground (a caster on another):
 /// those receivers then get the coarser grid.
-fn narrowest_smoothie(bounds: &[Aabb], frustum: &LightFrustum, size: SmoothieSize, receivers: ReceiverBound) -> f32 {
-    bounds
-        .iter()
-        .map(|b| {
-            let (_, deepest) = depth_range(&frustum.view, b);
-            size.largest_reach(deepest, frustum.window_of(b), receivers)
-        })
-        .fold(f32::INFINITY, f32::min)
+fn narrowest_smoothie(casters: &[CasterExtent], size: SmoothieSize, receivers: ReceiverBound) -> f32 {
+    casters.iter().map(|c| size.largest_reach(c.deepest, c.window, receivers)).fold(f32::INFINITY, f32::min)
 }
 
 /// How many times the map and buffer of `size` texels are halved: while the narrowest
@@ -810,7 +812,8 @@ mod tests {
             let frustum = fit_spot_frustum(light, None, &casters, &ground).frustum.expect("in view");
             // The ground's plane bounds the receivers (receiver_bound), 8 below the light.
             let ground = Some(frustum.view.y_axis.truncate() / -8.0);
-            casters_meet(&casters, &frustum, size, ReceiverBound { far: frustum.far, ground }, 1e-3)
+            let extents = casters.map(|b| CasterExtent::new(&frustum, &b));
+            casters_meet(&extents, size, ReceiverBound { far: frustum.far, ground }, 1e-3)
         };
         // Each plate's smoothies reach R (1 − b/r) = 0.5 (1 − 7/8) ≈ 0.06 m beyond it on the
         // ground, and two texels, 0.014 m: plates nearer than 0.15 m meet, plates further apart
@@ -823,6 +826,7 @@ mod tests {
         // A caster reaching the light's plane covers every direction.
         let casters = [still, Aabb { min: Vec3::new(3.0, 7.0, -0.3), max: Vec3::new(3.6, 9.0, 0.3) }];
         let frustum = fit_spot_frustum(light, None, &casters[..1], &ground).frustum.expect("in view");
-        assert!(casters_meet(&casters, &frustum, size, ReceiverBound::up_to(frustum.far), 1e-3));
+        let extents = casters.map(|b| CasterExtent::new(&frustum, &b));
+        assert!(casters_meet(&extents, size, ReceiverBound::up_to(frustum.far), 1e-3));
     }
 }
