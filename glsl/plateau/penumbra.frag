@@ -3,7 +3,8 @@
 // (outer only, or one caster: the texture's only channel). Centred (issue 20), t is the
 // distance to the hard shadow's boundary in half widths on both of its sides, so only
 // silhouettes on that boundary may write it: the mask must be lit a couple of texels off the
-// foot, across the edge (either way: an edge seen edge-on has no reliable outward side). An
+// foot, across the edge (either way: an edge seen edge-on has no reliable outward side; a
+// sheet's vertices probe it along the edge, penumbra.vert, a cone's fragments here). An
 // interior fold (a torus's far rim, the cow's legs under its body) has shadow on both sides and
 // writes nothing, so no bright streak crosses the umbra.
 //
@@ -25,7 +26,8 @@ layout(constant_id = 2) const bool SHEETS = false;
 // hard edges lie inside the hard shadow, so they write only where the mask is lit.
 layout(constant_id = 3) const bool PARTIAL = false;
 
-layout(set = 0, binding = 1) uniform sampler2D mask;
+#include "mask.glsl"
+#include "probes.glsl"
 
 layout(location = 0) in vec2 in_local;
 layout(location = 1) in vec2 in_uv;
@@ -34,10 +36,11 @@ layout(location = 3) flat in vec4 in_shape1;
 layout(location = 4) flat in vec2 in_edge;
 layout(location = 5) flat in vec2 in_normal;
 layout(location = 6) flat in uint in_caster;
+// Centred sheets: what the vertices probed along the hard edge (penumbra.vert), and at how
+// many samples.
+layout(location = 7) flat in uvec4 in_probes;
+layout(location = 8) flat in uint in_samples;
 layout(location = 0) out vec2 out_t;
-
-// How far off the foot the mask is probed, in texels: past the hard edge's rasterisation.
-const float PROBE = 2.0;
 
 float cross2(vec2 a, vec2 b) {
     return a.x * b.y - a.y * b.x;
@@ -88,12 +91,6 @@ float wedge_t(vec2 y, vec2 lean) {
     return yy == 0.0 ? 0.0 : yy / (yl + sqrt(yl * yl + (1.0 - dot(lean, lean)) * yy));
 }
 
-uint caster_at(vec2 texel) {
-    ivec2 size = textureSize(mask, 0);
-    ivec2 i = clamp(ivec2(floor(texel)), ivec2(0), size - 1);
-    return uint(round(texelFetch(mask, i, 0).r * 65535.0));
-}
-
 // t in the channel of caster number `caster` (r odd, g even), the other left lit; one caster's
 // in r, the texture's only channel.
 vec2 in_channel(uint caster, float t) {
@@ -123,22 +120,34 @@ void main() {
         out_t = in_channel(in_caster, t);
         return;
     }
-    vec2 size = vec2(textureSize(mask, 0));
-    // The foot: on a sheet's hard edge, a cone's apex.
-    vec2 foot = (in_shape1.zw + s * in_edge) * size;
-    vec2 from_foot = in_uv * size - foot;
-    // A cone's normal at this pixel is the direction from its apex.
-    vec2 across = in_normal != vec2(0.0) ? in_normal * size : from_foot;
-    if (dot(across, across) < 1e-8) {
-        discard; // on the apex itself: the sheets meeting there write it
-    }
-    vec2 probe = PROBE * normalize(across);
     uint here = OVERLAPS ? caster_at(gl_FragCoord.xy) : 0u;
-    // Both probes, read once for either case: llvmpipe runs both branches below.
-    uint a = caster_at(foot + probe), b = caster_at(foot - probe);
+    // Whether the foot lies on the hard shadow's boundary (one side lit), whether its own
+    // caster lies on both sides, and whether the fragment is on the edge's outer side.
+    bool boundary, own_both, outer_half;
+    if (SHEETS) {
+        // The vertices probed the edge at the middles of pieces a texel long at most: the
+        // foot's.
+        uint k = min(uint(s * float(in_samples)), in_samples - 1u);
+        boundary = probed(in_probes.xy, k);
+        own_both = probed(in_probes.zw, k);
+        vec2 from_foot = in_uv - (in_shape1.zw + s * in_edge);
+        outer_half = dot(from_foot, in_normal) > 0.0;
+    } else {
+        // A cone's foot is its apex, and its normal at this pixel the direction from there.
+        vec2 size = vec2(textureSize(mask, 0));
+        vec2 foot = in_shape1.zw * size;
+        vec2 from_foot = in_uv * size - foot;
+        if (dot(from_foot, from_foot) < 1e-8) {
+            discard; // on the apex itself: the sheets meeting there write it
+        }
+        vec2 probe = PROBE * normalize(from_foot);
+        uint a = caster_at(foot + probe), b = caster_at(foot - probe);
+        boundary = a == 0u || b == 0u;
+        own_both = a == in_caster && b == in_caster;
+        outer_half = false;
+    }
     if (here == 0u || here == in_caster) {
-        // On the hard shadow's boundary one side is lit.
-        if (a != 0u && b != 0u) {
+        if (!boundary) {
             discard;
         }
         out_t = in_channel(in_caster, t);
@@ -146,8 +155,7 @@ void main() {
     }
     // Over another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
     // something other than its own caster across it.
-    bool outer_half = in_normal != vec2(0.0) && dot(from_foot, in_normal * size) > 0.0;
-    if (!outer_half || (a == in_caster && b == in_caster)) {
+    if (!outer_half || own_both) {
         discard;
     }
     out_t = in_channel(here + 1u, t);

@@ -7,15 +7,24 @@
 // as the triangle apex, rim(from), rim(to) and the trapezoid from that chord out to the rim's
 // tangent at the middle angle (geometry::plateau::Wedge). Both interpolate coordinates in which
 // the fragment shader solves for t exactly.
+//
+// Centred, a sheet writes only where its foot lies on the hard shadow's boundary, which
+// probes.comp found along its hard edge: the fragments read that, and a sheet with its foot
+// nowhere on the boundary (an interior fold's) is not drawn.
 #include "interface.glsl"
+#include "probes.glsl"
 
+// As penumbra.frag's.
+layout(constant_id = 0) const bool CENTRED = false;
 // Sheets (6 vertices a primitive) or wedges (9).
 layout(constant_id = 2) const bool SHEETS = false;
+layout(constant_id = 3) const bool PARTIAL = false;
 
 layout(set = 0, binding = 0) uniform Plateau { PlateauView plateau; };
 // Wedges: apex, lean | axes (columns) | from, to, caster, -. Sheets: a, b | ta, tb | normal,
 // caster, hull (bits). Wedges first, then sheets: gl_VertexIndex counts from the first.
 layout(std430, set = 0, binding = 2) readonly buffer Sides { vec4 sides[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Probes { SheetProbes probes[]; };
 
 // Sheets: p − a, in plane units. Wedges: y = x + lean, the point from the apex in unit-disk
 // coordinates. Both affine in the plane point, so interpolated exactly.
@@ -29,6 +38,9 @@ layout(location = 3) flat out vec4 out_shape1;
 layout(location = 4) flat out vec2 out_edge;
 layout(location = 5) flat out vec2 out_normal;
 layout(location = 6) flat out uint out_caster;
+// Centred sheets: their mask probes along the hard edge (probes.comp), for the fragments.
+layout(location = 7) flat out uvec4 out_probes;
+layout(location = 8) flat out uint out_samples;
 
 void main() {
     uint per = SHEETS ? 6u : 9u;
@@ -37,6 +49,8 @@ void main() {
     vec4 r0 = sides[record], r1 = sides[record + 1u], r2 = sides[record + 2u];
     vec2 extent = plateau.window.zw - plateau.window.xy;
     vec2 p;
+    out_probes = uvec4(0u);
+    out_samples = 1u;
     if (SHEETS) {
         vec2 corners[4] = vec2[4](r0.xy, r0.zw, r1.zw, r1.xy); // a, b, tb, ta
         p = corners[(floatBitsToUint(r2.w) >> (2u * corner)) & 3u];
@@ -47,6 +61,14 @@ void main() {
         out_edge = (r0.zw - a) / extent;
         out_normal = r2.xy / extent;
         out_caster = uint(r2.z);
+        if (CENTRED && !PARTIAL) {
+            SheetProbes probed = probes[uint(gl_VertexIndex) / per - plateau.sheets.x];
+            out_probes = probed.bits;
+            out_samples = probed.samples.x;
+            if (probed.samples.y != 0u) {
+                p = a; // every corner at one point: nothing rasterised
+            }
+        }
     } else {
         vec2 apex = r0.xy, lean = r0.zw;
         mat2 axes = mat2(r1.xy, r1.zw);

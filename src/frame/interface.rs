@@ -2,7 +2,7 @@
 //! the GPU, checked for size here (only vec4/mat4 members, so std140 and std430 agree).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec4};
+use glam::{Mat4, UVec4, Vec4};
 
 /// Camera and light for every pass of a frame.
 #[repr(C)]
@@ -67,6 +67,9 @@ pub struct PlateauView {
     pub plane_u: Vec4,
     pub plane_v: Vec4,
     pub window: Vec4,
+    /// Centred: the first sheet's record in the sides buffer and the number of sheets, whose
+    /// mask probes `glsl/plateau/probes.comp` finds; then 0, 0.
+    pub sheets: UVec4,
 }
 
 /// One caster's silhouette dispatch, padded to 256 bytes (see `LightSample`).
@@ -153,7 +156,7 @@ const _: () = assert!(std::mem::size_of::<FrameGlobals>() == 2 * 64 + 7 * 16);
 const _: () = assert!(std::mem::size_of::<ObjectData>() == 2 * 64 + 16);
 const _: () = assert!(std::mem::size_of::<LightView>() == 2 * 64 + 4 * 16);
 const _: () = assert!(std::mem::size_of::<LightSample>() == 256);
-const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 5 * 16);
+const _: () = assert!(std::mem::size_of::<PlateauView>() == 64 + 6 * 16);
 const _: () = assert!(std::mem::size_of::<SilhouetteParams>() == 256);
 const _: () = assert!(std::mem::size_of::<SampleView>() == 256);
 const _: () = assert!(std::mem::size_of::<VolumeParams>() == 256);

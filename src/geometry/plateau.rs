@@ -319,6 +319,20 @@ impl Sheet {
         a.lerp(b, s).lerp(ta.lerp(tb, s), t)
     }
 
+    /// The sheet cut across its hard edge into `n` equal pieces (n ≥ 1), each the patch over
+    /// its range of s: together the same patch, each t where it was. Centred, a sheet's
+    /// vertices probe the mask at a bounded number of samples along the hard edge
+    /// (`glsl/plateau/penumbra.vert`), so a long edge is drawn in pieces short enough for a
+    /// sample every texel.
+    pub fn pieces(&self, n: u32) -> impl Iterator<Item = Sheet> + '_ {
+        let n = n.max(1);
+        (0..n).map(move |k| {
+            let [s0, s1] = [k, k + 1].map(|k| k as f32 / n as f32);
+            let [a, b, ta, tb] = [(s0, 0.0), (s1, 0.0), (s0, 1.0), (s1, 1.0)].map(|(s, t)| self.point(s, t));
+            Sheet::new(a, b, ta, tb, self.normal.into(), self.caster)
+        })
+    }
+
     /// The plateau parameter at `p` and the hard edge's parameter s of its foot: the smallest t
     /// of the patch over `p` (where it folds over itself two cover it; min blending of the
     /// tessellation kept the smaller), `None` off the patch. What `glsl/plateau/penumbra.frag`
@@ -930,6 +944,31 @@ mod tests {
             prop_assert!(found <= t + 1e-3 || apart < 2e-3 * (1.0 + p.length()), "t {found} above the point's own {t}");
             let back = sheet.point(at, found);
             prop_assert!((back - p).length() < 2e-3 * (1.0 + p.length()), "({at}, {found}) maps to {back}, not {p}");
+        }
+
+        /// A sheet cut into pieces is the same patch: a point of the whole at (s, t) lies in
+        /// the piece over s, at the same t, and inside that piece's hull.
+        #[test]
+        fn sheets_cut_into_pieces_keep_their_patch(
+            corners in prop::array::uniform4((-2.0f32..2.0, -2.0f32..2.0)),
+            n in 1u32..9, s in 0.0f32..=1.0, t in 0.0f32..=1.0,
+        ) {
+            let [a, b, tb, ta] = corners.map(Vec2::from);
+            let sheet = Sheet::new(a, b, ta, tb, Vec2::Y, 3.0);
+            let pieces: Vec<Sheet> = sheet.pieces(n).collect();
+            prop_assert_eq!(pieces.len(), n as usize);
+            let k = ((s * n as f32) as usize).min(n as usize - 1);
+            let piece = &pieces[k];
+            let local = s * n as f32 - k as f32;
+            let (whole, part) = (sheet.point(s, t), piece.point(local, t));
+            prop_assert!((whole - part).length() < 1e-4 * (1.0 + whole.length()), "{whole} vs {part}");
+            prop_assert!(in_triangles(&piece.hull_points(), whole), "{whole} outside piece {k}'s hull");
+            prop_assert_eq!((piece.normal, piece.caster), (sheet.normal, sheet.caster));
+            // The pieces join: each starts where the last ended.
+            for w in pieces.windows(2) {
+                prop_assert!((Vec2::from(w[0].b) - Vec2::from(w[1].a)).length() < 1e-5 * (1.0 + whole.length()));
+                prop_assert!((Vec2::from(w[0].tb) - Vec2::from(w[1].ta)).length() < 1e-5 * (1.0 + whole.length()));
+            }
         }
 
         /// A wedge's t is exact: the point a fraction t of the way from the apex to the rim at

@@ -56,6 +56,13 @@ impl Access {
         access: vk::AccessFlags2::SHADER_SAMPLED_READ,
         layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     };
+    /// Sampled by compute and fragment shaders (color).
+    pub const COMPUTE_FRAGMENT_READ: Access = Access {
+        stage: vk::PipelineStageFlags2::from_raw(
+            vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw() | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
+        ),
+        ..Access::FRAGMENT_READ
+    };
     /// Sampled by fragment shaders (depth).
     pub const DEPTH_FRAGMENT_READ: Access = Access {
         stage: vk::PipelineStageFlags2::FRAGMENT_SHADER,
@@ -156,6 +163,12 @@ impl BufferAccess {
             vk::AccessFlags2::SHADER_STORAGE_READ.as_raw() | vk::AccessFlags2::SHADER_STORAGE_WRITE.as_raw(),
         ),
     };
+    /// Written by a compute shader.
+    pub const COMPUTE_WRITE: BufferAccess =
+        BufferAccess { stage: vk::PipelineStageFlags2::COMPUTE_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_WRITE };
+    /// Read as a storage buffer by vertex shaders.
+    pub const VERTEX_STORAGE_READ: BufferAccess =
+        BufferAccess { stage: vk::PipelineStageFlags2::VERTEX_SHADER, access: vk::AccessFlags2::SHADER_STORAGE_READ };
     /// Generated geometry drawn indirectly: the vertices and the draw's arguments.
     pub const INDIRECT_DRAW: BufferAccess = BufferAccess {
         stage: vk::PipelineStageFlags2::from_raw(

@@ -1,0 +1,24 @@
+// A centred sheet's probes of the umbra mask along its hard edge, which probes.comp writes,
+// penumbra.vert passes on and penumbra.frag reads.
+#ifndef SOFTSHADOW_PLATEAU_PROBES_GLSL
+#define SOFTSHADOW_PLATEAU_PROBES_GLSL
+
+// Most samples a sheet's probes hold (a bit each in each half of `bits`): the CPU cuts longer
+// sheets into pieces, for a sample every texel.
+const uint SAMPLES = 64u;
+
+// A centred sheet's probes of the mask along its hard edge (probes.comp): per sample, the
+// middles of `samples.x` equal pieces from a to b, whether the mask is lit on either side of
+// the foot (bits.xy) and whether the sheet's own caster covers both sides (bits.zw);
+// samples.y: 1 where the sheet can write nowhere.
+struct SheetProbes {
+    uvec4 bits;
+    uvec4 samples;
+};
+
+// Sample k's bit in a 64-bit set.
+bool probed(uvec2 bits, uint k) {
+    return ((bits[k >> 5u] >> (k & 31u)) & 1u) != 0u;
+}
+
+#endif
