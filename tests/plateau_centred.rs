@@ -319,3 +319,27 @@ fn one_caster_s_texture_reads_as_the_channels_do() {
     }
     finish(e);
 }
+
+/// Sized to its penumbra (`penumbra_texels`): a plate 1 m up under a light of radius 0.5 at 6 m
+/// casts a penumbra 0.2 m wide, 85 texels of the 1024² texture over its 2.4 m shadow, so the
+/// textures are halved twice, and the centred penumbra, smooth across its width, stays where the
+/// full texture puts it against the reference.
+#[test]
+fn a_wide_penumbra_keeps_its_accuracy_on_a_quarter_of_the_texture() {
+    let s = plate(1.0, 1.0, 6.0, 0.5, 0.0, 1.5);
+    let mut e = engine();
+    let truth = reference(&mut e, &s, 128);
+    let sized = render_with(&mut e, &s, "plateau", &[], 128);
+    let full = render_with(&mut e, &s, "plateau", &[("penumbra_texels", "0")], 128);
+    let quarter = render_with(&mut e, &s, "plateau", &[("penumbra_texels", "0"), ("texture_size", "256")], 128);
+    finish(e);
+    assert_eq!(largest_difference(&sized, &quarter), 0.0, "a quarter of the texture, as asked for outright");
+    let (sized, full) = (Metrics::between(&sized, &truth).unwrap(), Metrics::between(&full, &truth).unwrap());
+    assert!(
+        sized.penumbra_rmse <= full.penumbra_rmse + 0.002,
+        "penumbra RMSE {} on a quarter of the texture, {} on the whole",
+        sized.penumbra_rmse,
+        full.penumbra_rmse
+    );
+    assert!(sized.leak_rate <= full.leak_rate, "leaks {} vs {}", sized.leak_rate, full.leak_rate);
+}

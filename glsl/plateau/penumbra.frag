@@ -53,10 +53,18 @@ const float FOLD_SLACK = 1e-4;
 
 // A sheet's smallest t over this fragment and its foot's s on the hard edge: the inverse of the
 // bilinear map q = s·e + t·f + s·t·g (q = p − a), whose t solves (f × g)·t² + (f × e − q × g)·t −
-// q × e = 0, in the form without cancellation (Sheet::at). False off the patch.
-bool sheet_t(out float t, out float s) {
+// q × e = 0, in the form without cancellation (Sheet::at). False off the patch. `texel`: the
+// texel's size in plane units. Below t = 0, half a texel of slack: rasterisation snaps the hard
+// edge, which a sheet's inner and outer halves share, to the subpixel grid, and can hand one
+// half a fragment of the other's; there t is 0 whichever half draws it. With f32's slack alone
+// (plate, 256² texture) a texel 0.001 texels inside went to the outer half, whose t of −1.5e-4
+// it dropped: nothing was drawn there, a lit speckle on the hard edge.
+bool sheet_t(vec2 texel, out float t, out float s) {
     vec2 e = in_shape0.xy, f = in_shape0.zw, q = in_local;
     vec2 g = in_shape1.xy - f - e;
+    // At most half the width: a sheet narrower than a texel takes no more than its own.
+    float widest = sqrt(max(dot(f, f), dot(f + g, f + g))); // |ta − a|, |tb − b|
+    float below = clamp(0.5 * max(texel.x, texel.y) / widest, SHEET_SLACK, 0.5);
     float qa = cross2(f, g), qb = cross2(f, e) - cross2(q, g), qc = -cross2(q, e);
     // Near a fold line d can round below 0 and s swings with t: a root there counts if it maps
     // back to q (Sheet::at).
@@ -68,7 +76,7 @@ bool sheet_t(out float t, out float s) {
     t = 2.0;
     for (int k = 0; k < 2; k++) {
         float r = roots[k];
-        if (r < -SHEET_SLACK || r > 1.0 + SHEET_SLACK || r >= t) {
+        if (r < -below || r > 1.0 + SHEET_SLACK || r >= t) {
             continue;
         }
         vec2 side = e + g * r;
@@ -98,9 +106,11 @@ vec2 in_channel(uint caster, float t) {
 }
 
 void main() {
+    // Before any discard: derivatives need every fragment of the quad.
+    vec2 texel = fwidth(in_local);
     float t, s = 0.0;
     if (SHEETS) {
-        if (!sheet_t(t, s)) {
+        if (!sheet_t(texel, t, s)) {
             discard;
         }
     } else {

@@ -483,6 +483,16 @@ impl PlateauGeometry {
         self.unbounded |= other.unbounded;
     }
 
+    /// The narrowest half width of any sheet's penumbra (plane units): the least distance from
+    /// a hard edge's end to its tangent point, infinite without sheets. Edges with no width at
+    /// either end (lying on the plane) have no sheet; one end on the plane gives 0.
+    pub fn narrowest_half_width(&self) -> f32 {
+        let width = |s: &Sheet| {
+            (Vec2::from(s.ta) - Vec2::from(s.a)).length().min((Vec2::from(s.tb) - Vec2::from(s.b)).length())
+        };
+        self.sheets.iter().map(width).fold(f32::INFINITY, f32::min)
+    }
+
     /// The part of a cone over the rim angles `from`..`to` (radians, `from` < `to` ≤ `from` +
     /// 2π), as pieces of at most [`WEDGE_SPAN`]. A cone without area (a flat base) draws nothing.
     fn push_wedge(&mut self, cone: &Cone, (from, to): (f32, f32), caster: f32) {
@@ -1262,6 +1272,38 @@ mod tests {
                 assert!(a * 2 < b, "shape {shape}: {a} of {b}");
             }
         }
+    }
+
+    /// The narrowest penumbra a texture must resolve (the technique's `penumbra_texels`): under
+    /// a light overhead a level slab's silhouette is its top face's rim, whose half width is
+    /// R·h/(H − h) at height h; a slab tilted onto the ground touches it, where the width is 0.
+    #[test]
+    fn the_narrowest_half_width_is_the_lowest_silhouettes() {
+        let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
+        let light = PlateauLight {
+            position: Vec3::Y * 9.0,
+            radius: 0.5,
+            size: PenumbraSize::Physical { scale: 1.0 },
+            penumbra: Penumbra::Centred,
+            wedges: true,
+        };
+        for height in [0.3f32, 1.0, 4.0] {
+            let g = sides(&light, &caster, &Mat4::from_translation(Vec3::Y * height), 1.0);
+            let rim = height + 0.05;
+            let want = 0.5 * rim / (9.0 - rim);
+            let got = g.narrowest_half_width();
+            assert!((got - want).abs() < 0.02 * want, "at {height} m: {got}, want {want}");
+        }
+        // A plate tilted by 0.5 rad about its middle, raised until its low edge meets the ground.
+        let (plate, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.0, 2.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let caster = Caster { positions: &plate, triangles: &triangles, adjacency: &adjacency };
+        let tilted = Mat4::from_translation(Vec3::Y * 0.5f32.sin()) * Mat4::from_rotation_z(0.5);
+        let g = sides(&light, &caster, &tilted, 1.0);
+        assert!(g.narrowest_half_width() < 1e-4, "touching the ground: {}", g.narrowest_half_width());
+        assert_eq!(PlateauGeometry::default().narrowest_half_width(), f32::INFINITY);
     }
 
     /// A flat plate, cones of one radius: each corner's only wedge is its quarter turn, outside

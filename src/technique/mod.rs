@@ -5,6 +5,7 @@ mod accumulation;
 pub mod blob;
 pub mod concentric;
 mod falloff;
+mod grid;
 mod ground;
 pub mod knobs;
 mod object_ids;

@@ -74,6 +74,7 @@ use bytemuck::cast_slice;
 use glam::{Mat4, Vec3, Vec4};
 
 use super::falloff::{FALLOFF, PENUMBRA};
+use super::grid::{self, Halving};
 use super::knobs::{Knob, Params};
 use super::registry::{APPROXIMATION_BOUND, CostGoal, Kind, Receivers, Setting, SweepKnobs, TechniqueInfo};
 use super::shadow_map::{self, DEFAULT_BIASES, EMPTY_DEPTH, SHADOW_MAP_SIZE, ShadowMapPass};
@@ -202,6 +203,21 @@ const GPU_SILHOUETTES: Knob = Knob {
     help: "1: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); 0: on the CPU",
 };
 
+/// Map and buffer sized to the narrowest smoothie: where every caster's smoothies span many
+/// texels, a coarser grid resolves them as well ([`grid::halvings`]): across a smoothie's width
+/// its alpha is linear, which the resolve's bilinear lookup holds exactly on any grid, and what
+/// a texel costs is where the map's hard edge lies, a texel of which moves V by about 1/texels
+/// of the penumbra. At 10 (bench's scenes at 512², lavapipe, against the reference with
+/// samples=256 and against 0, interleaved runs): contact, open_mesh, overlap, plate and sphere
+/// get half the size, low_light a quarter, the rest keep it (the wingnut, the box on the ground, the torus, the default scene's small casters
+/// near the ground); the penumbra RMSE of each moved by at most 0.0003 (contact 0.0351 →
+/// 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 → 0.0152), the frame 0.63–0.90× (low_light
+/// 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 → 32.5).
+const PENUMBRA_TEXELS: Knob = Knob {
+    help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
+    ..grid::PENUMBRA_TEXELS
+};
+
 /// Silhouette chains merged before the smoothies are made (`geometry::chains`), within this
 /// many smoothie-buffer texels in position and in reach: fewer edges and corners on fine
 /// meshes. The CPU path only: the compute path draws every silhouette edge.
@@ -216,28 +232,6 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// run) the buffer pass takes 0.4–0.9× its unmerged time on the suite and the scale scenes, but
 /// the wingnut's penumbra, a few texels wide near contact, goes from RMSE 0.018 to 0.189: a
 /// bound in texels is too loose where the penumbra is narrow.
-/// Map and buffer sized to the narrowest smoothie: where every caster's smoothies span many
-/// texels, a coarser grid resolves them as well (see [`halvings`]). At 10 (bench's scenes at
-/// 512², lavapipe, against the reference with samples=256 and against 0, interleaved runs):
-/// contact, open_mesh, overlap, plate and sphere get half the size, low_light a quarter, the
-/// rest keep it (the wingnut, the box on the ground, the torus, the default scene's small casters
-/// near the ground); the penumbra RMSE of each moved by at most 0.0003 (contact 0.0351 →
-/// 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 → 0.0152), the frame 0.63–0.90× (low_light
-/// 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 → 32.5).
-const PENUMBRA_TEXELS: Knob = Knob {
-    name: "penumbra_texels",
-    default: 10.0,
-    min: 0.0,
-    max: 1024.0,
-    integer: false,
-    help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
-};
-/// The most [`halvings`] take off the map and buffer sizes, and the least size they leave.
-const MAX_HALVINGS: u32 = 2;
-const MIN_HALVED_SIZE: u32 = 128;
-/// How many times [`PENUMBRA_TEXELS`] a frame's narrowest smoothie must span to take a coarser
-/// grid than the frame before ([`halvings`]).
-const HALVING_MARGIN: f32 = 1.25;
 const MERGE: Knob = Knob {
     name: "merge",
     default: 0.0,
@@ -431,9 +425,8 @@ pub struct Smoothie {
     casters: CasterMeshes,
     /// The compute path, made when first asked for.
     gpu: Option<GpuSilhouettes>,
-    /// The last frame's [`halvings`] with the knobs they came from (texels, largest size),
-    /// which the next frame keeps within their margin if those are the same.
-    halved: Option<(f32, u32, u32)>,
+    /// The map and buffer's last halvings.
+    halving: Halving,
 }
 
 impl Smoothie {
@@ -451,7 +444,7 @@ impl Smoothie {
             silhouettes: Vec::new(),
             casters: CasterMeshes::default(),
             gpu: None,
-            halved: None,
+            halving: Halving::default(),
         })
     }
 
@@ -553,9 +546,7 @@ impl Technique for Smoothie {
         let texels = if centred { params.get(&PENUMBRA_TEXELS) as f32 } else { 0.0 };
         let (size, buffer_size) = (params.get(&MAP_SIZE) as u32, params.get(&SMOOTHIE_SIZE) as u32);
         let finest = size.min(buffer_size);
-        let previous = self.halved.filter(|&(t, f, _)| (t, f) == (texels, finest)).map(|(_, _, h)| h);
-        let halved = halvings(narrowest / window * finest as f32, finest, texels, previous);
-        self.halved = Some((texels, finest, halved));
+        let halved = self.halving.next(narrowest / window * finest as f32, finest, texels);
         let (size, buffer_size) = (size >> halved, buffer_size >> halved);
         // The ground's height (none: infinitely far below) and the light view origin's, for r in
         // pass 2.
@@ -726,29 +717,6 @@ fn narrowest_smoothie(casters: &[CasterExtent], size: SmoothieSize, receivers: R
     casters.iter().map(|c| size.largest_reach(c.deepest, c.window, receivers)).fold(f32::INFINITY, f32::min)
 }
 
-/// How many times the map and buffer of `size` texels are halved: while the narrowest
-/// smoothie, `narrowest` texels of them wide, still spans `texels` texels of the halved grid,
-/// at most [`MAX_HALVINGS`] times and never below [`MIN_HALVED_SIZE`]; never with `texels` 0.
-/// Across a smoothie's width its alpha is linear, which the resolve's bilinear lookup holds
-/// exactly on any grid; what a grid's texel costs is where the map's hard edge lies, a texel
-/// of which moves V by about 1/`texels` of the penumbra.
-///
-/// A switch of grids moves V where the hard edge crosses texels, by up to 0.13 at a few pixels
-/// (sphere, contact: 3 and 73 of 262144 pixels by more than 0.02, a change a moving caster
-/// would show as a flicker), so after the `previous` frame's count a coarser grid needs
-/// [`HALVING_MARGIN`] times the texels, and the count it had is kept while it still fits.
-fn halvings(narrowest: f32, size: u32, texels: f32, previous: Option<u32>) -> u32 {
-    if texels <= 0.0 || !narrowest.is_finite() {
-        return 0;
-    }
-    let fits = |h: u32, margin: f32| narrowest / (1u32 << h) as f32 >= texels * margin && size >> h >= MIN_HALVED_SIZE;
-    let most = |up_to: u32, margin: f32| (1..=up_to).take_while(|&h| fits(h, margin)).last().unwrap_or(0);
-    match previous {
-        None => most(MAX_HALVINGS, 1.0),
-        Some(previous) => most(MAX_HALVINGS, HALVING_MARGIN).max(most(previous.min(MAX_HALVINGS), 1.0)),
-    }
-}
-
 /// The smoothies' side for a caster within `bounds` seen through `view`.
 pub(super) fn penumbra(centred: bool, view: &Mat4, bounds: &Aabb) -> Penumbra {
     if centred {
@@ -770,34 +738,6 @@ enum Smoothies {
 mod tests {
     use super::*;
     use crate::geometry::fit_spot_frustum;
-
-    proptest::proptest! {
-        /// Halved, the narrowest smoothie still spans `texels`; halved once more it would not
-        /// (after a frame with fewer halvings: not by the margin), or the grid would pass its
-        /// limits; fewer than the frame before only where that frame's no longer fit.
-        #[test]
-        fn grids_halve_while_the_narrowest_smoothie_spans_enough_texels(
-            narrowest in 0.0f32..2000.0,
-            size_log in 4u32..14,
-            texels in 0.0f32..64.0,
-            previous in proptest::option::of(0u32..4),
-        ) {
-            let size = 1 << size_log;
-            let h = halvings(narrowest, size, texels, previous);
-            let fits = |h: u32, margin: f32| narrowest / (1u32 << h) as f32 >= texels * margin && size >> h >= MIN_HALVED_SIZE;
-            proptest::prop_assert!(h <= MAX_HALVINGS);
-            proptest::prop_assert!(texels > 0.0 || h == 0);
-            proptest::prop_assert!(h == 0 || fits(h, 1.0), "{h} halvings do not fit");
-            if texels > 0.0 {
-                // Up to the frame before's count no margin is needed; beyond it, the margin.
-                let margin = if previous.is_none_or(|p| h < p) { 1.0 } else { HALVING_MARGIN };
-                proptest::prop_assert!(h == MAX_HALVINGS || !fits(h + 1, margin), "{h} halvings after {previous:?}, one more would do");
-                if let Some(p) = previous.filter(|&p| p < h) {
-                    proptest::prop_assert!(fits(h, HALVING_MARGIN), "{h} halvings after {p} without the margin");
-                }
-            }
-        }
-    }
 
     #[test]
     fn casters_get_channels_only_where_their_smoothies_can_meet() {
