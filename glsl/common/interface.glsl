@@ -62,7 +62,7 @@ struct SilhouetteParams {
     mat4 model_view;  // object -> light view (+z away from the light)
     vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver;
                       // y, w: the caster's light-depth range (inner quads)
-    uvec4 counts;     // x: edges, y: mailbox stamp, z: output capacity in vertices, w: 1 for inner quads
+    uvec4 counts;     // x: edges, y: mailbox stamp, z: each kind's capacity in vertices (silhouettes.comp), w: 1 for inner quads
     vec4 light;       // x: how far the light lies behind the view's origin (PHYSICAL_SIZE);
                       // y: the caster's channel in the centred smoothie buffer (0 or 1);
                       // z: centred, the light's radius (partial silhouettes), else 0; w: PARTIAL_GAIN

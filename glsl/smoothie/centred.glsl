@@ -5,6 +5,11 @@
 #define SOFTSHADOW_SMOOTHIE_CENTRED_GLSL
 #include "buffer.glsl"
 
+// Which smoothies a draw holds (smoothie.rs's `Part`): the inner quads, or the outer smoothies.
+// Each kind is drawn apart, so a fragment runs only its own kind's code: llvmpipe runs both
+// branches of a test it cannot fold.
+layout(constant_id = 0) const bool INNER = false;
+
 // One fragment of a smoothie: an inner quad's linear α or an outer smoothie's remapped α', and
 // the depth code (depth.glsl) it is written with.
 struct Centred {
@@ -21,7 +26,7 @@ bool centred_fragment(out Centred c) {
     vec2 uv = gl_FragCoord.xy / light.kernel.x;
     float caster = map_at(uv);
     float alpha = linear_alpha();
-    c = Centred(in_range.y > 0.0, alpha, depth_code(light, in_b), 1.0);
+    c = Centred(INNER, alpha, depth_code(light, in_b), 1.0);
     if (c.inner) {
         // An inner texel counts only where the map's blocker is this caster (its depth within the
         // caster's range, within two texels' depth; not another caster in front or behind), and

@@ -17,7 +17,11 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
-layout(std430, set = 0, binding = 5) buffer Args { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
+// Two indirect draws: the outer smoothies', then the inner quads', each kind appended to its own
+// half of the vertex buffer, so that the smoothie pass draws each with its own shader
+// (smoothie.rs's `Part`).
+struct Draw { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
+layout(std430, set = 0, binding = 5) buffer Args { Draw draws[2]; };
 // x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel (src/geometry/smoothie.rs's
 // SmoothieVertex)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
@@ -77,10 +81,13 @@ void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 rang
 // Six vertices, two triangles: the quad q0 q1 q2 q3, with projective weights w (1/t on edges,
 // as src/geometry/smoothie.rs's SmoothieVertex::w).
 void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner, float w[4]) {
-    uint at = atomicAdd(vertex_count, 6u);
+    // An inner quad's range is its caster's depths, beyond 0; the outer smoothies' is 0 or −1.
+    uint kind = inner.range.y > 0.0 ? 1u : 0u;
+    uint at = atomicAdd(draws[kind].vertex_count, 6u);
     if (at + 6u > params.counts.z) {
-        return; // sized so that it never happens; never write past the buffer
+        return; // sized so that it never happens; never write past the kind's half
     }
+    at += kind * params.counts.z;
     const int order[6] = int[6](0, 1, 2, 0, 2, 3);
     for (int k = 0; k < 6; k++) {
         int o = order[k];

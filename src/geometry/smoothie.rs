@@ -157,9 +157,15 @@ impl SmoothieGeometry {
         self
     }
 
-    /// Every vertex, in drawing order.
+    /// Every vertex, in drawing order: the outer smoothies' ([`Self::outer_vertices`] of them),
+    /// then the inner quads'.
     pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
         self.edges.iter().chain(&self.corners).chain(&self.inner)
+    }
+
+    /// How many of [`Self::vertices`] come first, the outer smoothies' (edges and corners).
+    pub fn outer_vertices(&self) -> usize {
+        self.edges.len() + self.corners.len()
     }
 }
 

@@ -2,7 +2,7 @@
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
 //! invocation per edge finds silhouettes and pairs the edge ends at each silhouette vertex, then
 //! one more appends smoothie edges and corners (`glsl/smoothie/silhouettes.comp`); the smoothie
-//! pass draws them with an indirect draw. Each mesh's positions, triangles, edges and per-vertex
+//! pass draws them with two indirect draws, the outer smoothies and the inner quads apart. Each mesh's positions, triangles, edges and per-vertex
 //! stamped slots are uploaded once, while it is drawn. The output
 //! (one copy, not one per frame in flight) is only recomputed when a caster, the light view or
 //! the smoothie size changed: a static scene records no silhouette work after its first frame.
@@ -29,6 +29,8 @@ const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
+/// Two `VkDrawIndirectCommand`s: the outer smoothies', then the inner quads'.
+const DRAWS_BYTES: u64 = 32;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -107,7 +109,7 @@ impl GpuSilhouettes {
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER
             | vk::BufferUsageFlags::INDIRECT_BUFFER
             | vk::BufferUsageFlags::TRANSFER_DST;
-        let args = PerFrame::new(ctx, "smoothie draw", 16, FRAMES_IN_FLIGHT, usage)?;
+        let args = PerFrame::new(ctx, "smoothie draws", DRAWS_BYTES, FRAMES_IN_FLIGHT, usage)?;
         Ok(GpuSilhouettes {
             pipelines: Variants::default(),
             meshes: Uploads::new(MeshBuffers::destroy),
@@ -121,7 +123,8 @@ impl GpuSilhouettes {
 
     /// Records the silhouette dispatches of every caster seen through `view`, each from the mesh
     /// `cast` gives its scene object (the shadow mesh the map is drawn from, as on the CPU path);
-    /// returns the vertex buffer and the indirect draw arguments the smoothie pass draws from.
+    /// returns the vertex buffer and the arguments of the smoothie pass's two indirect draws
+    /// ([`DRAWS_BYTES`]).
     pub fn record(
         &mut self,
         frame: &mut FrameInputs<'_>,
@@ -140,18 +143,20 @@ impl GpuSilhouettes {
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
         // Six vertices per quad: one per edge (two with the inner quads, or a partial
-        // silhouette's two), at most three per corner.
+        // silhouette's two), at most three per corner; as many for each kind in its half of the
+        // buffer (the inner quads', centred).
         let quads_per_edge = 1 + centred as usize;
         let capacity: u64 = casters
             .iter()
             .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + 3 * o.mesh.positions.len()) as u64)
             .sum();
+        let halves = 1 + u64::from(centred);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         PerFrame::ensure(
             ctx,
             &mut self.vertices,
             "smoothies",
-            capacity.max(1) * VERTEX_BYTES,
+            halves * capacity.max(1) * VERTEX_BYTES,
             storage | vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
@@ -171,7 +176,7 @@ impl GpuSilhouettes {
         // Slot 0 holds the one copy of the output (earlier frames may still draw from it: the
         // barriers below order this frame's writes after their reads).
         let (vertices, args) = (self.vertices.as_ref().expect("ensured").range(0), self.args.range(0));
-        let args = vk::DescriptorBufferInfo { range: 16, ..args };
+        let args = vk::DescriptorBufferInfo { range: DRAWS_BYTES, ..args };
         let far = receivers.far;
         let ground = receivers.ground.map_or(Vec4::ZERO, |g| g.extend(1.0));
         let key = OutputKey {
@@ -213,7 +218,7 @@ impl GpuSilhouettes {
         // finish both before this frame's.
         buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::TRANSFER_WRITE);
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
-        update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0]));
+        update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0, 0, 1, capacity as u32, 0]));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
         for (i, &at) in meshes.iter().enumerate() {
             let mesh = self.meshes.get(at);
