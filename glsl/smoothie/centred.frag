@@ -45,7 +45,7 @@ void main() {
         discard;
     }
     if (c.inner) {
-        out_outer = vec2(1.0);
+        out_outer = vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0);
         out_inner = vec2(1.0 - c.code, with_channel(c.alpha, in_channel));
         out_odd = vec2(1.0, c.limit);
         return;

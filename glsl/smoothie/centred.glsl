@@ -10,6 +10,12 @@
 // branches of a test it cannot fold.
 layout(constant_id = 0) const bool INNER = false;
 
+// What an inner quad with α < 1 leaves in the outer smoothies' depth channel, where the
+// resolve's mask draw finds every smoothie with one gather (resolve.frag's near_smoothie): the
+// largest code below 1, behind every receiver the frustum holds, so that no receiver counts as
+// behind it.
+const float INNER_MARK = 65534.0 / 65535.0;
+
 // One fragment of a smoothie: an inner quad's linear α or an outer smoothie's remapped α', and
 // the depth code (depth.glsl) it is written with.
 struct Centred {

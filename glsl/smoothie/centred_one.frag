@@ -15,6 +15,6 @@ void main() {
     if (!centred_fragment(c)) {
         discard;
     }
-    out_outer = c.inner ? vec2(1.0) : vec2(c.code, c.alpha);
+    out_outer = c.inner ? vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0) : vec2(c.code, c.alpha);
     out_inner = c.inner ? vec2(1.0 - c.code, c.alpha) : vec2(1.0);
 }

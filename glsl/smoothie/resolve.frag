@@ -162,12 +162,9 @@ bool near_smoothie(vec2 uv, float umbra) {
     vec2 corner = (floor(smoothie_pos(uv)) + 1.0) / light.kernel.x;
     bool edge = umbra > 0.0 && umbra < 1.0;
     if (CENTRED) {
-        // An outer smoothie is written only with α' < 1 (centred.glsl), so its depth tells;
-        // an inner alpha of 1 reads 65534 or 65535 with its channel bit, else 65535.
-        vec4 b = textureGather(smoothies, corner, 0);
-        vec4 inner = textureGather(inner_smoothies, corner, 1);
-        float umbra_alpha = CHANNELS ? 65533.5 / 65535.0 : 1.0;
-        return edge || any(lessThan(b, vec4(1.0))) || any(lessThan(inner, vec4(umbra_alpha)));
+        // An outer smoothie is written only with α' < 1 (centred.glsl), so its depth tells, and
+        // an inner quad with α < 1 leaves its mark there too.
+        return edge || any(lessThan(textureGather(smoothies, corner, 0), vec4(1.0)));
     }
     if (umbra == 0.0) {
         return false; // outer only: the map's umbra stays umbra

@@ -2,10 +2,11 @@
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
 //! invocation per edge finds silhouettes and pairs the edge ends at each silhouette vertex, then
 //! one more appends smoothie edges and corners (`glsl/smoothie/silhouettes.comp`); the smoothie
-//! pass draws them with two indirect draws, the outer smoothies and the inner quads apart. Each mesh's positions, triangles, edges and per-vertex
-//! stamped slots are uploaded once, while it is drawn. The output
-//! (one copy, not one per frame in flight) is only recomputed when a caster, the light view or
-//! the smoothie size changed: a static scene records no silhouette work after its first frame.
+//! pass draws them with two indirect draws, the outer smoothies and the inner quads apart. Each
+//! mesh's positions, triangles, edges and per-vertex stamped slots are uploaded once, while it
+//! is drawn. The output (one copy, not one per frame in flight) is only recomputed when a
+//! caster, the light view or the smoothie size changed: a static scene records no silhouette
+//! work after its first frame.
 
 use std::sync::Arc;
 
