@@ -1,15 +1,17 @@
 #version 460
-// The centred smoothie buffer (issue 20) of several casters, in one pass and three targets,
-// every channel composited with minimum blending, so the outcome is the same in any drawing
-// order; every channel clears to 1, and each kind of smoothie writes 1 where it has nothing to
-// say, which the minimum leaves as it is. One caster needs no channels: centred_one.frag.
+// The centred smoothie buffer (issue 20) of several casters, in one pass (a draw for the outer
+// smoothies, one for the inner quads: centred.glsl's INNER) and three targets, every channel
+// composited with minimum blending, so the outcome is the same in any drawing order; every
+// channel clears to 1, and each kind of smoothie writes 1 where it has nothing to say, which
+// the minimum leaves as it is. One caster needs no channels: centred_one.frag.
 //
-// Target 0: the outer smoothies' nearest depth b (its code, depth.glsl) and the even casters'
-// remapped alpha α' (Equation 1). Target 1: the inner quads' 1 − code(b), the farthest inner
-// depth, and their alpha α. Target 2: the odd casters' α' and the inner quads' limit
-// (centred.glsl), the nearest. Two channels each: llvmpipe clears a four-channel 16-bit
-// target at about a third of the bytes per second of a two-channel one (plate, 1024², the
-// clear alone: 3.2 ms for one RGBA target, 1.3 ms for two RG targets of the same bytes).
+// Target 0: the outer smoothies' nearest depth b (its code, depth.glsl; where only inner quads
+// with α < 1 lie, centred.glsl's INNER_MARK) and the even casters' remapped alpha α' (Equation
+// 1). Target 1: the inner quads' 1 − code(b), the farthest inner depth, and their alpha α.
+// Target 2: the odd casters' α' and the inner quads' limit (centred.glsl), the nearest. Two
+// channels each: llvmpipe clears a four-channel 16-bit target at about a third of the bytes per
+// second of a two-channel one (plate, 1024², the clear alone: 3.2 ms for one RGBA target, 1.3
+// ms for two RG targets of the same bytes).
 //
 // Two outer channels, one per caster parity (SmoothieVertex::channel): the resolve multiplies
 // their visibilities. Where two casters' penumbrae

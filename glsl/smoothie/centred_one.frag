@@ -1,10 +1,11 @@
 #version 460
 // The centred smoothie buffer (issue 20) of one caster: two targets, minimum blending, every
-// channel cleared to 1. Target 0: the outer smoothies' nearest depth b (its code, depth.glsl)
-// and remapped alpha α' (Equation 1); target 1: the inner quads' 1 − code(b) (the farthest
-// inner depth) and alpha α (the shallowest, the lightest: see centred.frag), as centred.frag's
-// first two, less the channel bit. With no other caster there are no channels to keep apart
-// and no limits (one caster has no other beside it): centred.frag's third target is not needed.
+// channel cleared to 1. Target 0: the outer smoothies' nearest depth b (its code, depth.glsl;
+// where only inner quads with α < 1 lie, centred.glsl's INNER_MARK) and remapped alpha α'
+// (Equation 1); target 1: the inner quads' 1 − code(b) (the farthest inner depth) and alpha α
+// (the shallowest, the lightest: see centred.frag), as centred.frag's first two, less the
+// channel bit. With no other caster there are no channels to keep apart and no limits (one
+// caster has no other beside it): centred.frag's third target is not needed.
 #include "centred.glsl"
 
 layout(location = 0) out vec2 out_outer;
