@@ -29,8 +29,8 @@ pub use memory::{Buffer, PerFrame};
 pub use pipeline::{Blend, DepthState, Descriptor, Fullscreen, Pipeline, PipelineDesc, Variants, VertexInput};
 pub use reflect::Binding;
 pub use render::{
-    Attachment, RenderPass, copy_buffer, dispatch, draw_fullscreen, draw_generated, draw_indexed, draw_indirect,
-    draw_vertices, fullscreen, update_buffer,
+    Attachment, DRAW_COMMAND_BYTES, RenderPass, copy_buffer, dispatch, draw_fullscreen, draw_generated, draw_indexed,
+    draw_indirect, draw_vertices, fullscreen, update_buffer,
 };
 pub use swapchain::{Acquired, NativeWindow, PresentMode, Swapchain, SwapchainRequest, is_srgb};
 pub use target::{Target, TargetDesc, ensure};

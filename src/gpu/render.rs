@@ -181,6 +181,10 @@ pub fn draw_indexed(
     }
 }
 
+/// The bytes of one `VkDrawIndirectCommand`: vertex count, instance count, first vertex, first
+/// instance.
+pub const DRAW_COMMAND_BYTES: u64 = std::mem::size_of::<vk::DrawIndirectCommand>() as u64;
+
 /// Draws the vertices of `vertices` as many as the `VkDrawIndirectCommand` at `args` says
 /// (geometry a compute shader generated), with the bound pipeline.
 pub fn draw_indirect(
@@ -191,7 +195,7 @@ pub fn draw_indirect(
 ) {
     unsafe {
         ctx.device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.buffer], &[vertices.offset]);
-        ctx.device.cmd_draw_indirect(cmd, args.buffer, args.offset, 1, 16);
+        ctx.device.cmd_draw_indirect(cmd, args.buffer, args.offset, 1, DRAW_COMMAND_BYTES as u32);
     }
 }
 

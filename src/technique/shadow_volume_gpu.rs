@@ -23,15 +23,13 @@ use crate::frame::interface::VolumeParams;
 use crate::geometry::NO_FACE;
 use crate::geometry::silhouette::FacePlanes;
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, PerFrame, Pipeline, UploadMark, Uploads, buffer_barrier, copy_buffer,
-    dispatch, draw_indirect, shaders, upload,
+    Buffer, BufferAccess, Context, DRAW_COMMAND_BYTES, Descriptor, PerFrame, Pipeline, UploadMark, Uploads,
+    buffer_barrier, copy_buffer, dispatch, draw_indirect, shaders, upload,
 };
 use crate::scene::{Mesh, MeshId};
 
 const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<VolumeParams>() as u64;
-/// An indirect draw command: vertex count, instance count, first vertex, first instance.
-const COMMAND_BYTES: u64 = 16;
 /// Bytes per volume vertex: position, at infinity, object (as the CPU path's).
 const VERTEX_BYTES: u64 = 20;
 /// Draws per caster group and point: sides, caps, turned caps.
@@ -188,7 +186,7 @@ impl GpuVolumes {
                 });
             }
         }
-        self.command_bytes = (commands.len() as u64 * COMMAND_BYTES).max(COMMAND_BYTES);
+        self.command_bytes = (commands.len() as u64 * DRAW_COMMAND_BYTES).max(DRAW_COMMAND_BYTES);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let usage = storage | vk::BufferUsageFlags::INDIRECT_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         let commands_buffer = grow(ctx, &mut self.commands, "volume draws", self.command_bytes, usage)?;
@@ -268,8 +266,8 @@ impl GpuVolumes {
         let commands = self.commands.as_ref().expect("prepared").range();
         let command = vk::DescriptorBufferInfo {
             buffer: commands.buffer,
-            offset: commands.offset + ((p * self.groups + g) * PARTS + part) as u64 * COMMAND_BYTES,
-            range: COMMAND_BYTES,
+            offset: commands.offset + ((p * self.groups + g) * PARTS + part) as u64 * DRAW_COMMAND_BYTES,
+            range: DRAW_COMMAND_BYTES,
         };
         let vertices = self.vertices.as_ref().expect("prepared").range();
         draw_indirect(frame.ctx, frame.cmd, vertices, command);

@@ -90,9 +90,9 @@ use crate::geometry::smoothie::{
 };
 use crate::geometry::{Aabb, LightFrustum};
 use crate::gpu::{
-    Access, Attachment, Blend, Context, DepthState, Descriptor, Guard, PerFrame, Pipeline, PipelineDesc, RenderPass,
-    Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices, ensure, shaders,
-    transition,
+    Access, Attachment, Blend, Context, DRAW_COMMAND_BYTES, DepthState, Descriptor, Guard, PerFrame, Pipeline,
+    PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices,
+    ensure, shaders, transition,
 };
 use crate::scene::{Mesh, Object};
 
@@ -765,7 +765,8 @@ impl Smoothies {
                 (count > 0).then_some((part, Draw::Vertices { vertices, first, count }))
             }
             Smoothies::Indirect { vertices, args } => {
-                let one = vk::DescriptorBufferInfo { offset: args.offset + 16 * i as u64, range: 16, ..args };
+                let offset = args.offset + i as u64 * DRAW_COMMAND_BYTES;
+                let one = vk::DescriptorBufferInfo { offset, range: DRAW_COMMAND_BYTES, ..args };
                 Some((part, Draw::Indirect { vertices, args: one }))
             }
             Smoothies::None => None,

@@ -21,8 +21,8 @@ use crate::frame::interface::SilhouetteParams;
 use crate::geometry::silhouette::PARTIAL_GAIN;
 use crate::geometry::smoothie::{Penumbra, ReceiverBound, SmoothieSize};
 use crate::gpu::{
-    Buffer, BufferAccess, Context, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark, Uploads, Variants,
-    buffer_barrier, dispatch, shaders, update_buffer, upload,
+    Buffer, BufferAccess, Context, DRAW_COMMAND_BYTES, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark,
+    Uploads, Variants, buffer_barrier, dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId, Object};
 
@@ -31,7 +31,7 @@ const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
 /// Two `VkDrawIndirectCommand`s: the outer smoothies', then the inner quads'.
-const DRAWS_BYTES: u64 = 32;
+const DRAWS_BYTES: u64 = 2 * DRAW_COMMAND_BYTES;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -219,6 +219,8 @@ impl GpuSilhouettes {
         // finish both before this frame's.
         buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::TRANSFER_WRITE);
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
+        // No vertices yet; the outer smoothies drawn from the buffer's start, the inner quads
+        // from its second half.
         update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0, 0, 1, capacity as u32, 0]));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
         for (i, &at) in meshes.iter().enumerate() {
