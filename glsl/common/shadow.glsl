@@ -56,6 +56,14 @@ ShadowLookup shadow_lookup(LightView light, vec3 from, vec3 p, vec3 n) {
     return s;
 }
 
+// Where p itself falls in a light's map, for the receiver-plane tests below, which need no
+// offset from p: false behind the light or outside the frustum.
+bool map_uv(LightView light, vec3 p, out vec2 uv) {
+    vec4 clip = light.view_proj * vec4(p, 1.0);
+    uv = clip.xy / clip.w * 0.5 + 0.5;
+    return clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+}
+
 // The four texels nearest `uv` in the size x size map at texel `origin` of `atlas` (the
 // footprint stays inside it): their depths in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0), and
 // the bilinear weights.
@@ -121,14 +129,15 @@ bool in_front_of(LightView light, ReceiverPlane r, vec2 texel, float depth) {
     return dot(r.n, b - r.p) > r.margin + 2e-3 * distance(b, r.p);
 }
 
-// compare_bilinear against the receiver's plane instead of one depth (1 = lit).
-float compare_bilinear_plane(sampler2D map, LightView light, ReceiverPlane r, vec2 uv) {
+// compare_bilinear against the receiver's plane instead of one depth (1 = lit), in the size x
+// size map at texel `origin` of `atlas`.
+float compare_bilinear_plane(sampler2D atlas, vec2 origin, LightView light, ReceiverPlane r, vec2 uv) {
     float size = light.bias.w;
     vec2 texel_pos = clamp(uv * size - 0.5, vec2(0.0), vec2(size - 1.001));
     vec2 f = fract(texel_pos);
     vec2 i0 = floor(texel_pos);
     // Gathering at the corner shared by the four texels: (i0,j1) (i1,j1) (i1,j0) (i0,j0).
-    vec4 d = textureGather(map, (i0 + 1.0) / vec2(textureSize(map, 0)), 0);
+    vec4 d = textureGather(atlas, (origin + i0 + 1.0) / vec2(textureSize(atlas, 0)), 0);
     vec4 lit = vec4(!in_front_of(light, r, i0 + vec2(0.0, 1.0), d.x), !in_front_of(light, r, i0 + vec2(1.0, 1.0), d.y),
                     !in_front_of(light, r, i0 + vec2(1.0, 0.0), d.z), !in_front_of(light, r, i0, d.w));
     return bilinear(f, lit);

@@ -66,7 +66,7 @@ float pcf_disk_plane(sampler2D map, LightView light, ReceiverPlane r, vec2 centr
     float angle = pixel_rotation();
     float lit = 0.0;
     for (int i = 0; i < n; i++) {
-        lit += compare_bilinear_plane(map, light, r, centre + vogel(i, n, angle) * radius_texels / size);
+        lit += compare_bilinear_plane(map, vec2(0.0), light, r, centre + vogel(i, n, angle) * radius_texels / size);
     }
     return lit / float(n);
 }
@@ -113,7 +113,7 @@ float pcss(sampler2D map, LightView light, ShadowLookup l, vec3 p, vec3 n, float
     float filter_texels = radius * max(z - blocker, 0.0) / (blocker * z) * per_tangent;
     // 3. PCF over it; below half a texel it is the bilinear hard edge (contact hardening).
     if (filter_texels < 0.5) {
-        return compare_bilinear_plane(map, light, r, l.uv);
+        return compare_bilinear_plane(map, vec2(0.0), light, r, l.uv);
     }
     return pcf_disk_plane(map, light, r, l.uv, filter_texels, taps);
 }

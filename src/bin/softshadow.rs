@@ -601,12 +601,14 @@ fn bench(args: &BenchArgs) -> Result<()> {
             frames: None,
         };
         let (scene, truth_settings) = load(&what)?;
-        // Reference images are cached by a hash of the scene file and the reference's settings.
+        // Reference images are cached by a hash of the scene file, the reference's settings and
+        // the build's shaders, so that a ground truth whose shaders changed is rendered anew.
         let text = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
         let key = {
             use std::hash::{Hash, Hasher};
             let mut h = std::collections::hash_map::DefaultHasher::new();
             (text, size, truth_settings.params.to_string(), env!("CARGO_PKG_VERSION")).hash(&mut h);
+            softshadow::gpu::shaders::ALL.iter().for_each(|s| s.words.hash(&mut h));
             h.finish()
         };
         let cached = cache.join(format!("{name}-{key:016x}.ref"));
