@@ -234,6 +234,36 @@ fn a_convex_casters_terminator_follows_the_light_above_its_tangent_plane() {
     assert!(rmse <= 0.08, "RMSE {rmse} over the sphere's {pixels} terminator pixels");
 }
 
+/// Sized to its narrowest smoothie (`penumbra_texels`), which starts on a silhouette: the
+/// sphere's lies on its equator, well above the bottom of its bounds, so its smoothies are twice
+/// as wide as the bounds' deepest point would give, and the CPU path, which knows its
+/// silhouette, takes a map and buffer of 256² where the compute path, which takes the bounds,
+/// keeps 512². The coarser grid stays as close to the truth.
+#[test]
+fn the_grid_is_sized_from_where_the_smoothies_start() {
+    let s = suite_scene("sphere");
+    let mut e = engine();
+    let truth = reference(&mut e, &s, 128);
+    let grid = |n: &'static str| [("penumbra_texels", "0"), ("shadow_map_size", n), ("smoothie_size", n)];
+    let sized = render_with(&mut e, &s, "smoothie", &[], 128);
+    let quarter = render_with(&mut e, &s, "smoothie", &grid("256"), 128);
+    let half = render_with(&mut e, &s, "smoothie", &grid("512"), 128);
+    let gpu = [("gpu_silhouettes", "1")];
+    let gpu_sized = render_with(&mut e, &s, "smoothie", &gpu, 128);
+    let gpu_half = render_with(&mut e, &s, "smoothie", &[&gpu[..], &grid("512")].concat(), 128);
+    finish(e);
+    assert_eq!(largest_difference(&sized, &quarter), 0.0, "the CPU path: a map and buffer of 256²");
+    assert_eq!(largest_difference(&gpu_sized, &gpu_half), 0.0, "the compute path: of 512²");
+    let [sized, half] = [&sized, &half].map(|v| Metrics::between(v, &truth).unwrap());
+    assert!(
+        sized.penumbra_rmse <= half.penumbra_rmse + 0.002,
+        "penumbra RMSE {} at 256², {} at 512²",
+        sized.penumbra_rmse,
+        half.penumbra_rmse
+    );
+    assert!(sized.leak_rate <= half.leak_rate, "leaks {} vs {}", sized.leak_rate, half.leak_rate);
+}
+
 #[test]
 fn the_physical_size_is_the_error_minimising_one() {
     let scales = ["0.5", "0.8", "1", "1.25", "2"];

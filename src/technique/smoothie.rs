@@ -147,8 +147,9 @@ const QUARTER_TEXELS: Setting = &[("shadow_map_size", "512"), ("smoothie_size", 
 /// to match ([`QUARTER_TEXELS`]; bench, 512², lavapipe, one run) the frame cost 0.65–0.91× the
 /// default's and the penumbra RMSE stayed within 0.0007 on seven suite scenes, but where
 /// penumbrae are a few texels wide it broke: the wingnut near contact 0.018 → 0.050 with 341
-/// leaking pixels where there were none, `default` 0.057 → 0.063 and leaks 155 → 493, the torus
-/// 0.0089 → 0.0107: hence [`PENUMBRA_TEXELS`], which halves them only where the smoothies are
+/// leaking pixels where there were none, `default` 0.057 → 0.063 and leaks 155 → 493 (the torus
+/// 0.0089 → 0.0107 against the reference before its receiver-plane tests; against today's,
+/// 0.0088 → 0.0082): hence [`PENUMBRA_TEXELS`], which halves them only where the smoothies are
 /// wide. Both sizes are the largest the map and buffer get.
 const MAP_SIZE: Knob = Knob { default: 1024.0, ..SHADOW_MAP_SIZE };
 const SMOOTHIE_SIZE: Knob = Knob {
@@ -209,10 +210,15 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// a texel costs is where the map's hard edge lies, a texel of which moves V by about 1/texels
 /// of the penumbra. At 10 (bench's scenes at 512², lavapipe, against the reference with
 /// samples=256 and against 0, interleaved runs): contact, open_mesh, overlap, plate and sphere
-/// get half the size, low_light a quarter, the rest keep it (the wingnut, the box on the ground, the torus, the default scene's small casters
-/// near the ground); the penumbra RMSE of each moved by at most 0.0003 (contact 0.0351 →
-/// 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 → 0.0152), the frame 0.63–0.90× (low_light
-/// 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 → 32.5).
+/// got half the size, low_light a quarter, the rest kept it; the penumbra RMSE of each moved by
+/// at most 0.0003 (contact 0.0351 → 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 →
+/// 0.0152), the frame 0.63–0.90× (low_light 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 →
+/// 32.5). Measured from the silhouettes ([`narrowest_smoothie`]) rather than the casters'
+/// bounds, the sphere gets a quarter (its equator, not its bottom: penumbra RMSE 0.0151 →
+/// 0.0150); the wingnut and `default`'s small casters keep the full size, their silhouettes
+/// reaching the ground, and so, just short of the 20 texels a halving needs, do two_boxes (17)
+/// and the torus (19), whose penumbra RMSE at half the size is 0.0488 and 0.0082 against 0.0488
+/// and 0.0088 (bench's `QUARTER_TEXELS` row).
 const PENUMBRA_TEXELS: Knob = Knob {
     help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
     ..grid::PENUMBRA_TEXELS
@@ -448,47 +454,74 @@ impl Smoothie {
         })
     }
 
-    /// The smoothies of every caster through this frame's light view; silhouettes are found
-    /// again only for casters or a light that moved.
+    /// Finds the silhouettes of every caster again where it or the light moved.
+    fn find_silhouettes(&mut self, frame: &FrameInputs<'_>, cast: &[Option<Arc<Mesh>>], centred: bool) {
+        let objects = &frame.scene.objects;
+        let light = frame.scene.light.position;
+        let partial_radius = if centred { frame.scene.light.radius } else { 0.0 };
+        self.silhouettes.resize_with(objects.len(), || None);
+        for ((o, mesh), cached) in objects.iter().zip(cast).zip(&mut self.silhouettes) {
+            let Some(mesh) = mesh else {
+                *cached = None;
+                continue;
+            };
+            let model = o.transform.matrix();
+            let key = SilhouetteKey { mesh: mesh.id(), model, light, partial_radius };
+            if cached.as_ref().is_some_and(|c| c.key == key) {
+                continue;
+            }
+            // In object space: the face planes built with the mesh against the light taken
+            // there, then the silhouette's own vertices through view · model, so a moved caster
+            // costs no transform of its whole mesh.
+            let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let facing = mesh.planes.light_facing(&model, light);
+            let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
+            let partial = partial_silhouettes(&caster, &mesh.planes, &facing, &model, light, partial_radius);
+            *cached = Some(CasterSilhouette { key, edges, partial });
+        }
+    }
+
+    /// Where each caster's silhouettes ([`Self::find_silhouettes`]) lie in `frustum`: the
+    /// caster's window, and the depths of its nearest and deepest silhouette vertices, where
+    /// its smoothies start; none for a caster without any.
+    fn silhouette_extents(
+        &self,
+        frame: &FrameInputs<'_>,
+        cast: &[Option<Arc<Mesh>>],
+        frustum: &LightFrustum,
+    ) -> Vec<CasterExtent> {
+        let objects = frame.scene.objects.iter().zip(cast).zip(&self.silhouettes);
+        let extent = |((o, mesh), silhouette): ((&Object, &Option<Arc<Mesh>>), &Option<CasterSilhouette>)| {
+            let (mesh, silhouette) = (mesh.as_ref()?, silhouette.as_ref()?);
+            let model = o.transform.matrix();
+            let view = frustum.view * model;
+            let ends = silhouette.edges.iter().flat_map(|(e, _)| *e);
+            let depths = ends.map(|v| view.transform_point3(mesh.positions[v as usize]).z);
+            let (near, deepest) = depths.fold((f32::INFINITY, f32::NEG_INFINITY), |(n, d), z| (n.min(z), d.max(z)));
+            let window = frustum.window_of(&mesh.bounds.transformed(&model));
+            (near <= deepest).then_some(CasterExtent { window, near, deepest })
+        };
+        objects.filter_map(extent).collect()
+    }
+
+    /// The smoothies of every caster ([`Self::find_silhouettes`]) through this frame's light
+    /// view.
     fn geometry(
-        &mut self,
+        &self,
         frame: &FrameInputs<'_>,
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
         (size, receivers): (SmoothieSize, ReceiverBound),
         (centred, tolerance): (bool, f32),
     ) -> SmoothieGeometry {
-        let objects = &frame.scene.objects;
-        let light = frame.scene.light.position;
-        self.silhouettes.resize_with(objects.len(), || None);
         let mut out = SmoothieGeometry::default();
-        let mut number = 0;
-        for ((o, mesh), cached) in objects.iter().zip(cast).zip(&mut self.silhouettes) {
-            let Some(mesh) = mesh else {
-                *cached = None;
-                continue;
-            };
-            // Casters numbered as the compute path numbers them: those that cast, in order.
-            number += 1;
-            let o = &Object { mesh: mesh.clone(), ..o.clone() };
-            let model = o.transform.matrix();
-            let partial_radius = if centred { frame.scene.light.radius } else { 0.0 };
-            let key = SilhouetteKey { mesh: o.mesh.id(), model, light, partial_radius };
-            // In object space: the face planes built with the mesh against the light taken
-            // there, then the silhouette's own vertices through view · model, so a moved caster
-            // costs no transform of its whole mesh.
-            let caster =
-                Caster { positions: &o.mesh.positions, triangles: &o.mesh.triangles, adjacency: &o.mesh.adjacency };
-            if cached.as_ref().is_none_or(|c| c.key != key) {
-                let facing = o.mesh.planes.light_facing(&model, light);
-                let edges = penumbra_edges(&caster, &facing, EdgeSource::Silhouettes);
-                let planes = &o.mesh.planes;
-                let partial = partial_silhouettes(&caster, planes, &facing, &model, light, partial_radius);
-                *cached = Some(CasterSilhouette { key, edges, partial });
-            }
-            let c = cached.as_ref().expect("set above");
-            let view = *view * model;
-            let penumbra = penumbra(centred, &view, &o.mesh.bounds);
+        let casters = frame.scene.objects.iter().zip(cast).zip(&self.silhouettes);
+        // Casters numbered as the compute path numbers them: those that cast, in order.
+        let casting = casters.filter_map(|((o, mesh), c)| Some((o, mesh.as_ref()?, c.as_ref().expect("found"))));
+        for (number, (o, mesh, c)) in (1..).zip(casting) {
+            let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
+            let view = *view * o.transform.matrix();
+            let penumbra = penumbra(centred, &view, &mesh.bounds);
             let mut geometry = if tolerance > 0.0 {
                 let merged = merged_silhouette(&view, &caster, &c.edges, (size, receivers), tolerance);
                 merged_smoothies(&view, &caster, &merged, (size, receivers), penumbra)
@@ -539,7 +572,17 @@ impl Technique for Smoothie {
         let [x0, y0, x1, y1] = frustum.window;
         let window = (x1 - x0).max(y1 - y0);
         let extents: Vec<CasterExtent> = bounds.iter().map(|b| CasterExtent::new(&frustum, b)).collect();
-        let narrowest = narrowest_smoothie(&extents, smoothie_size, receivers);
+        // The CPU path knows where the smoothies start, on the silhouettes; the compute path
+        // finds them only on the GPU, and takes the casters' bounds, which hold them (never a
+        // coarser grid, and a finer one where a caster's bounds reach deeper than its
+        // silhouettes: the torus, the box on the ground of two_boxes).
+        let gpu_silhouettes = params.is_on(&GPU_SILHOUETTES);
+        let narrowest = if gpu_silhouettes {
+            narrowest_smoothie(&extents, smoothie_size, receivers)
+        } else {
+            self.find_silhouettes(frame, &cast, centred);
+            narrowest_smoothie(&self.silhouette_extents(frame, &cast, &frustum), smoothie_size, receivers)
+        };
         // The outer-only form's penumbra begins at the map's hard edge, which a coarser grid
         // moves by its texel: a box's outline 0.5 mm off moved V by up to 0.063 at 512² against
         // 2/255 at 1024² (tests/smoothie.rs, a_finely_tessellated_outline_casts_*).
@@ -568,7 +611,7 @@ impl Technique for Smoothie {
         self.pass.record(frame, &frustum, size, biases, kernel, Some(&self.casters))?;
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
-        let source = if params.is_on(&GPU_SILHOUETTES) {
+        let source = if gpu_silhouettes {
             if self.gpu.is_none() {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }
@@ -718,11 +761,13 @@ fn casters_meet(casters: &[CasterExtent], size: SmoothieSize, receivers: Receive
     windows.iter().enumerate().any(|(i, a)| windows[i + 1..].iter().any(|b| meet(a, b)))
 }
 
-/// An estimate of the narrowest smoothie of casters within `bounds`, in tangent units: each
-/// caster's at its deepest point, where t = R/b is least and so is the part 1 − b/r its
-/// receivers can need of it (as [`smoothies`] cuts it); the least of them. Its receivers' own
-/// penumbrae are narrower still where they lie in front of the ground (a caster on another):
-/// those receivers then get the coarser grid.
+/// An estimate of the narrowest smoothie of `casters`, in tangent units: each caster's at the
+/// deepest point a smoothie of it starts from (its deepest silhouette vertex, or its bounds'
+/// deepest point, which lies no nearer), where t = R/b is least and so is the part 1 − b/r its
+/// receivers can need of it (as [`smoothies`] cuts it); the least of them. Partial silhouettes
+/// do not count: one is drawn only where it reaches further than the silhouette's
+/// ([`partial_smoothies`]). Its receivers' own penumbrae are narrower still where they lie in
+/// front of the ground (a caster on another): those receivers then get the coarser grid.
 fn narrowest_smoothie(casters: &[CasterExtent], size: SmoothieSize, receivers: ReceiverBound) -> f32 {
     casters.iter().map(|c| size.largest_reach(c.deepest, c.window, receivers)).fold(f32::INFINITY, f32::min)
 }
