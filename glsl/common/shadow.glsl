@@ -27,6 +27,15 @@ float apparent_radius(LightView light, vec3 from, vec3 p, float radius) {
     return radius * distance(p, origin) / max(distance(p, from), 1e-30);
 }
 
+// Where p falls in a light's map, 0..1 (row 0 at v = 0; the centre behind the light): false
+// behind the light or outside the frustum fitted around every caster. The receiver-plane tests
+// below take p itself; shadow_lookup, a point moved along the normal.
+bool map_uv(LightView light, vec3 p, out vec2 uv) {
+    vec4 clip = light.view_proj * vec4(p, 1.0);
+    uv = clip.w > 0.0 ? clip.xy / clip.w * 0.5 + 0.5 : vec2(0.5);
+    return clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
+}
+
 // Where a receiver point falls in a light's map.
 struct ShadowLookup {
     vec2 uv;      // in the map, 0..1 (row 0 at v = 0)
@@ -48,20 +57,9 @@ ShadowLookup shadow_lookup(LightView light, vec3 from, vec3 p, vec3 n) {
     float tan_theta = min(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / max(cos_theta, 1e-3), 8.0);
     float bias = texel * (light.bias.x + light.bias.y * tan_theta) + depth_rounding(light, p, z);
 
-    vec4 clip = light.view_proj * vec4(q, 1.0);
-    s.inside = clip.w > 0.0;
-    s.uv = s.inside ? clip.xy / clip.w * 0.5 + 0.5 : vec2(0.5);
-    s.inside = s.inside && all(greaterThanEqual(s.uv, vec2(0.0))) && all(lessThanEqual(s.uv, vec2(1.0)));
+    s.inside = map_uv(light, q, s.uv);
     s.depth = (light.view * vec4(q, 1.0)).z - bias;
     return s;
-}
-
-// Where p itself falls in a light's map, for the receiver-plane tests below, which need no
-// offset from p: false behind the light or outside the frustum.
-bool map_uv(LightView light, vec3 p, out vec2 uv) {
-    vec4 clip = light.view_proj * vec4(p, 1.0);
-    uv = clip.xy / clip.w * 0.5 + 0.5;
-    return clip.w > 0.0 && all(greaterThanEqual(uv, vec2(0.0))) && all(lessThanEqual(uv, vec2(1.0)));
 }
 
 // The four texels nearest `uv` in the size x size map at texel `origin` of `atlas` (the

@@ -94,7 +94,7 @@ use crate::gpu::{
     PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices,
     ensure, shaders, transition,
 };
-use crate::scene::{Mesh, Object};
+use crate::scene::Mesh;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "smoothie",
@@ -481,27 +481,24 @@ impl Smoothie {
         }
     }
 
-    /// Where each caster's silhouettes ([`Self::find_silhouettes`]) lie in `frustum`: the
-    /// caster's window, and the depths of its nearest and deepest silhouette vertices, where
-    /// its smoothies start; none for a caster without any.
-    fn silhouette_extents(
-        &self,
-        frame: &FrameInputs<'_>,
-        cast: &[Option<Arc<Mesh>>],
-        frustum: &LightFrustum,
-    ) -> Vec<CasterExtent> {
+    /// Where each caster's smoothies start ([`Self::find_silhouettes`]), as
+    /// [`narrowest_smoothie`] takes it: the caster's window in `frustum` and its deepest
+    /// silhouette vertex; nothing for a caster without a silhouette.
+    fn silhouette_starts<'a>(
+        &'a self,
+        frame: &'a FrameInputs<'_>,
+        cast: &'a [Option<Arc<Mesh>>],
+        frustum: &'a LightFrustum,
+    ) -> impl Iterator<Item = ([f32; 4], f32)> + 'a {
         let objects = frame.scene.objects.iter().zip(cast).zip(&self.silhouettes);
-        let extent = |((o, mesh), silhouette): ((&Object, &Option<Arc<Mesh>>), &Option<CasterSilhouette>)| {
+        objects.filter_map(|((o, mesh), silhouette)| {
             let (mesh, silhouette) = (mesh.as_ref()?, silhouette.as_ref()?);
             let model = o.transform.matrix();
             let view = frustum.view * model;
             let ends = silhouette.edges.iter().flat_map(|(e, _)| *e);
-            let depths = ends.map(|v| view.transform_point3(mesh.positions[v as usize]).z);
-            let (near, deepest) = depths.fold((f32::INFINITY, f32::NEG_INFINITY), |(n, d), z| (n.min(z), d.max(z)));
-            let window = frustum.window_of(&mesh.bounds.transformed(&model));
-            (near <= deepest).then_some(CasterExtent { window, near, deepest })
-        };
-        objects.filter_map(extent).collect()
+            let deepest = ends.map(|v| view.transform_point3(mesh.positions[v as usize]).z).reduce(f32::max)?;
+            Some((frustum.window_of(&mesh.bounds.transformed(&model)), deepest))
+        })
     }
 
     /// The smoothies of every caster ([`Self::find_silhouettes`]) through this frame's light
@@ -572,21 +569,25 @@ impl Technique for Smoothie {
         let [x0, y0, x1, y1] = frustum.window;
         let window = (x1 - x0).max(y1 - y0);
         let extents: Vec<CasterExtent> = bounds.iter().map(|b| CasterExtent::new(&frustum, b)).collect();
-        // The CPU path knows where the smoothies start, on the silhouettes; the compute path
-        // finds them only on the GPU, and takes the casters' bounds, which hold them (never a
-        // coarser grid, and a finer one where a caster's bounds reach deeper than its
-        // silhouettes: the torus, the box on the ground of two_boxes).
         let gpu_silhouettes = params.is_on(&GPU_SILHOUETTES);
-        let narrowest = if gpu_silhouettes {
-            narrowest_smoothie(&extents, smoothie_size, receivers)
-        } else {
+        if !gpu_silhouettes {
             self.find_silhouettes(frame, &cast, centred);
-            narrowest_smoothie(&self.silhouette_extents(frame, &cast, &frustum), smoothie_size, receivers)
-        };
+        }
         // The outer-only form's penumbra begins at the map's hard edge, which a coarser grid
         // moves by its texel: a box's outline 0.5 mm off moved V by up to 0.063 at 512² against
         // 2/255 at 1024² (tests/smoothie.rs, a_finely_tessellated_outline_casts_*).
         let texels = if centred { params.get(&PENUMBRA_TEXELS) as f32 } else { 0.0 };
+        // The CPU path knows where the smoothies start, on the silhouettes; the compute path
+        // finds them only on the GPU, and takes the casters' bounds, which hold them: never a
+        // coarser grid, and a narrower estimate where a caster's bounds reach deeper than its
+        // silhouettes (the sphere, the torus, the box on the ground of two_boxes).
+        let narrowest = if texels <= 0.0 {
+            f32::INFINITY
+        } else if gpu_silhouettes {
+            narrowest_smoothie(extents.iter().map(|c| (c.window, c.deepest)), smoothie_size, receivers)
+        } else {
+            narrowest_smoothie(self.silhouette_starts(frame, &cast, &frustum), smoothie_size, receivers)
+        };
         let (size, buffer_size) = (params.get(&MAP_SIZE) as u32, params.get(&SMOOTHIE_SIZE) as u32);
         let finest = size.min(buffer_size);
         let halved = self.halving.next(narrowest / window * finest as f32, finest, texels);
@@ -726,7 +727,7 @@ fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBo
 }
 
 /// Where a caster's bounds lie in the light view: their tangent window and depth range, which
-/// [`casters_meet`] and [`narrowest_smoothie`] both take.
+/// [`casters_meet`] takes, and the compute path's [`narrowest_smoothie`].
 struct CasterExtent {
     window: [f32; 4],
     near: f32,
@@ -761,15 +762,19 @@ fn casters_meet(casters: &[CasterExtent], size: SmoothieSize, receivers: Receive
     windows.iter().enumerate().any(|(i, a)| windows[i + 1..].iter().any(|b| meet(a, b)))
 }
 
-/// An estimate of the narrowest smoothie of `casters`, in tangent units: each caster's at the
-/// deepest point a smoothie of it starts from (its deepest silhouette vertex, or its bounds'
-/// deepest point, which lies no nearer), where t = R/b is least and so is the part 1 − b/r its
+/// An estimate of the narrowest smoothie of `casters` (each its window and the deepest point a
+/// smoothie of it starts from: its deepest silhouette vertex, or its bounds' deepest point,
+/// which lies no nearer), in tangent units: each caster's at that point, where t = R/b is least and so is the part 1 − b/r its
 /// receivers can need of it (as [`smoothies`] cuts it); the least of them. Partial silhouettes
 /// do not count: one is drawn only where it reaches further than the silhouette's
 /// ([`partial_smoothies`]). Its receivers' own penumbrae are narrower still where they lie in
 /// front of the ground (a caster on another): those receivers then get the coarser grid.
-fn narrowest_smoothie(casters: &[CasterExtent], size: SmoothieSize, receivers: ReceiverBound) -> f32 {
-    casters.iter().map(|c| size.largest_reach(c.deepest, c.window, receivers)).fold(f32::INFINITY, f32::min)
+fn narrowest_smoothie(
+    casters: impl Iterator<Item = ([f32; 4], f32)>,
+    size: SmoothieSize,
+    receivers: ReceiverBound,
+) -> f32 {
+    casters.map(|(window, deepest)| size.largest_reach(deepest, window, receivers)).fold(f32::INFINITY, f32::min)
 }
 
 /// The smoothies' side for a caster within `bounds` seen through `view`.
