@@ -219,6 +219,18 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// reaching the ground, and so, just short of the 20 texels a halving needs, do two_boxes (17)
 /// and the torus (19), whose penumbra RMSE at half the size is 0.0488 and 0.0082 against 0.0488
 /// and 0.0088 (bench's `QUARTER_TEXELS` row).
+///
+/// On a straight edge 10 is more than the penumbra needs (examples/grid_texels.rs,
+/// docs/grid_texels.png: plate and sphere under lights of ¼ to 2× their radius, fixed grids
+/// against the reference): a halving added no penumbra RMSE, to 1e-4, down to 5.5 texels of the
+/// coarser grid, 0.0002–0.0011 at 2.8–4.3, 0.0072 at 1.4. But this estimate is no narrowest
+/// penumbra: it takes the farthest ground over a caster's window, and none at all where a
+/// receiver dips below the plane. The slab leaning on the ground (`contact`) gets 38 texels,
+/// and at 8 it took 256² and lost (penumbra RMSE 0.036 → 0.046, 52 pixels leaking at its foot,
+/// bench, one run), so 10 stays. Taking each silhouette vertex's own ground instead gives the
+/// true narrowest, 0 at every contact: it would keep `contact` and `low_light` at 1024², and
+/// the torus (10 texels) too, where their coarser grids measured as accurate: the narrowest
+/// point is not what decides, how much of the edge is narrow is.
 const PENUMBRA_TEXELS: Knob = Knob {
     help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
     ..grid::PENUMBRA_TEXELS
