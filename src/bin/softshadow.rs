@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result, bail};
 use clap::{Parser, Subcommand};
 use softshadow::gpu::ContextOptions;
-use softshadow::measure::{FileTrace, Metrics, TimingReport, save_difference};
+use softshadow::measure::{FileTrace, Metrics, TimingReport, save_difference, total_median};
 use softshadow::scene::Scene;
 use softshadow::technique::registry::{Runs, ground_truth};
 use softshadow::technique::{Kind, Params, TECHNIQUES, TechniqueInfo, find};
@@ -632,6 +632,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
         // Real-time rows in interleaved rounds (measure::bench::ROUNDS), the last captured;
         // offline ones once, with the first.
         let mut measured = vec![Vec::new(); runs.len()];
+        let mut round_ms = vec![Vec::new(); runs.len()];
         let mut captures = vec![None; runs.len()];
         let rounds = round_frames(args.frames);
         for (round, &frames) in rounds.iter().enumerate() {
@@ -659,6 +660,9 @@ fn bench(args: &BenchArgs) -> Result<()> {
                     let title = format!("{name}: {technique} {setting}");
                     trace.cpu_slice(title.trim_end(), started, std::time::Instant::now(), label);
                 }
+                if !offline {
+                    round_ms[i].push(total_median(&timings));
+                }
                 measured[i].extend(timings);
                 if capture.is_some() {
                     captures[i] = capture;
@@ -673,6 +677,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
                 technique: info.name.to_string(),
                 setting: setting_label(sets),
                 timings,
+                round_ms: std::mem::take(&mut round_ms[i]),
                 metrics: Metrics::between(&capture, &truth)?,
                 pareto: false,
             });

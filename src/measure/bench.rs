@@ -20,6 +20,9 @@ pub struct BenchRow {
     /// The knobs set, `key=value` separated by spaces; empty for the defaults.
     pub setting: String,
     pub timings: TimingReport,
+    /// Each round's median GPU ms ([`ROUNDS`]), in order: how far a cost ratio between two
+    /// rows of the scene moved from round to round.
+    pub round_ms: Vec<f64>,
     pub metrics: Metrics,
     /// No other row of the scene is both cheaper and more accurate (penumbra RMSE).
     pub pareto: bool,
@@ -181,7 +184,13 @@ impl Goal {
         let mark = if self.met(of, base) { "✓" } else { "✗" };
         let leaking = |r: &BenchRow| (r.metrics.leak_rate * r.metrics.pixels as f64).round();
         match self.measure {
-            Measure::Cost { .. } => format!("{:.2} {mark}", self.value(of) / self.value(base)),
+            Measure::Cost { .. } => {
+                let ratio = format!("{:.2} {mark}", self.value(of) / self.value(base));
+                match round_ratios(of, base) {
+                    Some((least, most)) => format!("{ratio} ({least:.2}–{most:.2})"),
+                    None => ratio,
+                }
+            }
             Measure::Leaks => format!("{} vs {} px {mark}", leaking(of), leaking(base)),
         }
     }
@@ -243,8 +252,16 @@ pub fn goal_table(heading: &str, goals: Vec<Goal>, rows: &[BenchRow]) -> String 
     out + "\n\n"
 }
 
+/// The least and the greatest ratio of `of`'s GPU ms to `base`'s within one round, over the
+/// rounds both were timed in; none with fewer than two.
+fn round_ratios(of: &BenchRow, base: &BenchRow) -> Option<(f64, f64)> {
+    let ratios: Vec<f64> = of.round_ms.iter().zip(&base.round_ms).map(|(o, b)| o / b).collect();
+    (ratios.len() >= 2).then(|| ratios.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| (lo.min(r), hi.max(r))))
+}
+
 /// Headings of the report's goal tables.
-pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds.";
+pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds; in \
+     brackets the least and the greatest of the same ratio within one round, how far this machine's noise moved it.";
 pub const LEAK_HEADING: &str = "## Leak rule\n\nLight-leak rates (V above the reference by more than 0.1), the centred \
      default against the papers' outer-only form; ✓ where it leaks no more.";
 
@@ -445,6 +462,7 @@ mod tests {
             technique: technique.into(),
             setting: setting.into(),
             timings: TimingReport { gpu_ms_total_median: ms, ..Default::default() },
+            round_ms: Vec::new(),
             metrics: Metrics::default(),
             pareto: false,
         }
@@ -510,6 +528,28 @@ mod tests {
             assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
         }
         assert_eq!(goal_table(COST_HEADING, vec![soft], &rows[..1]), "");
+    }
+
+    /// The cell's ratio is the medians'; the bracket, the least and greatest ratio of one
+    /// round's medians, each row's round k against the baseline's round k.
+    #[test]
+    fn a_cost_cell_shows_how_far_the_rounds_moved_the_ratio() {
+        let timed =
+            |technique: &str, ms, rounds: &[f64]| BenchRow { round_ms: rounds.to_vec(), ..row("a", technique, "", ms) };
+        let rows = [timed("base", 10.0, &[8.0, 10.0, 12.0, 10.0]), timed("soft", 12.0, &[12.0, 11.0, 12.0, 12.5])];
+        let goal = Goal {
+            technique: "soft",
+            setting: String::new(),
+            baseline: "base",
+            baseline_setting: String::new(),
+            measure: Measure::Cost { max_ratio: 1.15 },
+        };
+        let table = goal_table(COST_HEADING, vec![goal.clone()], &rows);
+        assert!(table.lines().any(|l| l == "| a | 1.20 ✗ (1.00–1.50) |"), "{table}");
+        // One round: no spread to show.
+        let once = [timed("base", 10.0, &[10.0]), timed("soft", 11.0, &[11.0])];
+        let table = goal_table(COST_HEADING, vec![goal], &once);
+        assert!(table.lines().any(|l| l == "| a | 1.10 ✓ |"), "{table}");
     }
 
     #[test]

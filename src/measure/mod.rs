@@ -13,5 +13,5 @@ mod trace;
 pub use metrics::{GROSS_ERROR, Metrics, PENUMBRA, save_difference};
 pub use plot::{lines, tradeoff};
 pub use sheet::{Tile, contact_sheet};
-pub use timings::{PassSummary, TimingReport};
+pub use timings::{PassSummary, TimingReport, total_median};
 pub use trace::{FileTrace, Trace};

@@ -63,7 +63,7 @@ impl TimingReport {
                 }
             })
             .collect();
-        let totals: Vec<f64> = frames.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect();
+        let totals = frame_totals(frames);
         let record: Vec<f64> = frames.iter().map(FrameTimings::cpu_record_ms).collect();
         let mut cpu_ms = BTreeMap::from([("record".to_string(), percentile(&record, 0.5))]);
         let mut span_names: Vec<&'static str> = frames.iter().flat_map(|f| f.cpu.iter().map(|s| s.name)).collect();
@@ -90,6 +90,16 @@ impl TimingReport {
 }
 
 /// Nearest-rank percentile; 0 for no samples.
+/// Each frame's GPU ms, its passes summed.
+fn frame_totals(frames: &[FrameTimings]) -> Vec<f64> {
+    frames.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect()
+}
+
+/// The median of `frames`' GPU ms, as [`TimingReport::gpu_ms_total_median`] takes it.
+pub fn total_median(frames: &[FrameTimings]) -> f64 {
+    percentile(&frame_totals(frames), 0.5)
+}
+
 pub(crate) fn percentile(values: &[f64], q: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
