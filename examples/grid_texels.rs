@@ -1,5 +1,5 @@
 //! How many texels a centred smoothie's narrowest penumbra must span before a halved grid costs
-//! accuracy on straight edges: what `penumbra_texels` could be with an estimate that holds
+//! accuracy on straight edges: the evidence for the smoothie's `penumbra_texels`
 //! (src/technique/smoothie.rs, its `PENUMBRA_TEXELS`).
 //!
 //! The plate and sphere scenes under lights from a quarter to twice their radius: the centred

@@ -19,6 +19,11 @@ use softshadow::technique::registry::{APPROXIMATION_BOUND, find};
 const OUTER: &[(&str, &str)] = &[("penumbra", "0"), ("falloff", "0")];
 const CENTRED: &[(&str, &str)] = &[("penumbra", "1")];
 
+/// The knobs of a fixed map and buffer of `n`² (no sizing to the penumbrae).
+fn grid(n: &'static str) -> [(&'static str, &'static str); 3] {
+    [("penumbra_texels", "0"), ("shadow_map_size", n), ("smoothie_size", n)]
+}
+
 /// A strip 2 m wide (x in [−1, 1]), 6 m long, at `height`, lit from (−3, 10, 0) so that its
 /// shadow's right edge falls on the ground beside it: seen from above, `size` px over `half` m
 /// each way of x = `centre`.
@@ -244,7 +249,6 @@ fn the_grid_is_sized_from_where_the_smoothies_start() {
     let s = suite_scene("sphere");
     let mut e = engine();
     let truth = reference(&mut e, &s, 128);
-    let grid = |n: &'static str| [("penumbra_texels", "0"), ("shadow_map_size", n), ("smoothie_size", n)];
     let sized = render_with(&mut e, &s, "smoothie", &[], 128);
     let quarter = render_with(&mut e, &s, "smoothie", &grid("256"), 128);
     let half = render_with(&mut e, &s, "smoothie", &grid("512"), 128);
@@ -255,6 +259,27 @@ fn the_grid_is_sized_from_where_the_smoothies_start() {
     assert_eq!(largest_difference(&sized, &quarter), 0.0, "the CPU path: a map and buffer of 256²");
     assert_eq!(largest_difference(&gpu_sized, &gpu_half), 0.0, "the compute path: of 512²");
     as_accurate_on_fewer_texels(&sized, &half, &truth, "256² against 512²");
+}
+
+/// The narrowest smoothie is estimated on the ground behind a caster even where the caster dips
+/// into it: the slab leaning on the ground (`contact`), its penumbra vanishing at its foot, keeps
+/// the finest grid, while two_boxes, whose narrowest smoothie (on the lower box's top edges)
+/// spans 8.4 texels of 512², takes 512² and is as close to the truth there.
+#[test]
+fn a_caster_touching_the_ground_keeps_the_finest_grid() {
+    let mut e = engine();
+    let contact = suite_scene("contact");
+    let sized = render_with(&mut e, &contact, "smoothie", &[], 128);
+    let full = render_with(&mut e, &contact, "smoothie", &grid("1024"), 128);
+    assert_eq!(largest_difference(&sized, &full), 0.0, "contact: a map and buffer of 1024²");
+    let boxes = suite_scene("two_boxes");
+    let truth = reference(&mut e, &boxes, 128);
+    let sized = render_with(&mut e, &boxes, "smoothie", &[], 128);
+    let half = render_with(&mut e, &boxes, "smoothie", &grid("512"), 128);
+    let full = render_with(&mut e, &boxes, "smoothie", &grid("1024"), 128);
+    finish(e);
+    assert_eq!(largest_difference(&sized, &half), 0.0, "two_boxes: a map and buffer of 512²");
+    as_accurate_on_fewer_texels(&sized, &full, &truth, "two_boxes, 512² against 1024²");
 }
 
 #[test]

@@ -208,30 +208,23 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// texels, a coarser grid resolves them as well ([`grid::halvings`]): across a smoothie's width
 /// its alpha is linear, which the resolve's bilinear lookup holds exactly on any grid, and what
 /// a texel costs is where the map's hard edge lies, a texel of which moves V by about 1/texels
-/// of the penumbra. At 10 (bench's scenes at 512², lavapipe, against the reference with
-/// samples=256 and against 0, interleaved runs): contact, open_mesh, overlap, plate and sphere
-/// got half the size, low_light a quarter, the rest kept it; the penumbra RMSE of each moved by
-/// at most 0.0003 (contact 0.0351 → 0.0354, low_light 0.0118 → 0.0120, sphere 0.0155 →
-/// 0.0152), the frame 0.63–0.90× (low_light 42.8 → 27.0 ms, plate 35.6 → 28.2, overlap 35.9 →
-/// 32.5). Measured from the silhouettes ([`narrowest_smoothie`]) rather than the casters'
-/// bounds, the sphere gets a quarter (its equator, not its bottom: penumbra RMSE 0.0151 →
-/// 0.0150); the wingnut and `default`'s small casters keep the full size, their silhouettes
-/// reaching the ground, and so, just short of the 20 texels a halving needs, do two_boxes (17)
-/// and the torus (19), whose penumbra RMSE at half the size is 0.0488 and 0.0082 against 0.0488
-/// and 0.0088 (bench's `QUARTER_TEXELS` row).
+/// of the penumbra. The narrowest is estimated at each caster's deepest silhouette vertex
+/// ([`narrowest_smoothie`]), on the ground behind it.
 ///
-/// On a straight edge 10 is more than the penumbra needs (examples/grid_texels.rs,
-/// docs/grid_texels.png: plate and sphere under lights of ¼ to 2× their radius, fixed grids
-/// against the reference): a halving added no penumbra RMSE, to 1e-4, down to 5.5 texels of the
-/// coarser grid, 0.0002–0.0011 at 2.8–4.3, 0.0072 at 1.4. But this estimate is no narrowest
-/// penumbra: it takes the farthest ground over a caster's window, and none at all where a
-/// receiver dips below the plane. The slab leaning on the ground (`contact`) gets 38 texels,
-/// and at 8 it took 256² and lost (penumbra RMSE 0.036 → 0.046, 52 pixels leaking at its foot,
-/// bench, one run), so 10 stays. Taking each silhouette vertex's own ground instead gives the
-/// true narrowest, 0 at every contact: it would keep `contact` and `low_light` at 1024², and
-/// the torus (10 texels) too, where their coarser grids measured as accurate: the narrowest
-/// point is not what decides, how much of the edge is narrow is.
+/// 8 texels, from what a halving costs (examples/grid_texels.rs, docs/grid_texels.png: plate
+/// and sphere under lights of ¼ to 2× their radius, fixed grids of 1024², 512² and 256² against
+/// the reference): no penumbra RMSE, to 1e-4, while the narrowest smoothie spanned 5.5 texels
+/// of the coarser grid or more, 0.0002–0.0011 at 2.8–4.3 texels, 0.0072 at 1.4; and `contact`,
+/// the slab leaning on the ground, lost at 2.8 (256²: 0.036 → 0.046, 52 pixels leaking at its
+/// foot) and nothing at 5.6 (512²). So 8, about 1.5× the least that measured harmless: the
+/// suite's grids are low_light and the sphere 256², open_mesh, overlap, plate, the torus and
+/// two_boxes 512² (the last two at 9.5 and 8.4 texels of it: penumbra RMSE 0.0082 and 0.0488
+/// against 0.0088 and 0.0488 at 1024², bench's `QUARTER_TEXELS` row), `contact`, `default` and
+/// the wingnut 1024² (5.6, 1.3 and 0 texels of 512²). At 10, the first default, the torus and
+/// two_boxes kept 1024² for nothing; and before the estimate took the ground under a caster
+/// dipping into it, `contact` had got 512² from 38 texels, harmlessly, its foot uncounted.
 const PENUMBRA_TEXELS: Knob = Knob {
+    default: 8.0,
     help: "halve map and buffer (at most twice) while the narrowest smoothie spans this many texels; 0: off",
     ..grid::PENUMBRA_TEXELS
 };
@@ -593,12 +586,19 @@ impl Technique for Smoothie {
         // finds them only on the GPU, and takes the casters' bounds, which hold them: never a
         // coarser grid, and a narrower estimate where a caster's bounds reach deeper than its
         // silhouettes (the sphere, the torus, the box on the ground of two_boxes).
+        // The penumbra the grid must resolve lies on the receivers, the ground among them even
+        // where a caster dips into it, as one touching it does: the smoothies' cut above cannot
+        // take the plane there (part of that caster lies beyond it), but without it a slab
+        // leaning on the ground (`contact`) measured 38 texels at its foot, where its penumbra
+        // vanishes, and took a grid that lost accuracy there (see PENUMBRA_TEXELS).
+        let penumbra_receivers =
+            ReceiverBound { ground: ground_plane(frame, &frustum), ..ReceiverBound::up_to(frustum.far) };
         let narrowest = if texels <= 0.0 {
             f32::INFINITY
         } else if gpu_silhouettes {
-            narrowest_smoothie(extents.iter().map(|c| (c.window, c.deepest)), smoothie_size, receivers)
+            narrowest_smoothie(extents.iter().map(|c| (c.window, c.deepest)), smoothie_size, penumbra_receivers)
         } else {
-            narrowest_smoothie(self.silhouette_starts(frame, &cast, &frustum), smoothie_size, receivers)
+            narrowest_smoothie(self.silhouette_starts(frame, &cast, &frustum), smoothie_size, penumbra_receivers)
         };
         let (size, buffer_size) = (params.get(&MAP_SIZE) as u32, params.get(&SMOOTHIE_SIZE) as u32);
         let finest = size.min(buffer_size);
@@ -726,16 +726,22 @@ impl Technique for Smoothie {
 /// ground plane too where the light and every receiver in view lie above it.
 fn receiver_bound(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> ReceiverBound {
     let far = ReceiverBound::up_to(frustum.far);
-    let Some(ground) = frame.scene.ground else { return far };
+    let (Some(ground), Some(plane)) = (frame.scene.ground, ground_plane(frame, frustum)) else { return far };
     let height = frustum.centre().y - ground.height;
     // A receiver's bounds may touch the plane from below by rounding.
     let above = |p: &Vec3| p.y >= ground.height - 1e-4 * height;
-    if height <= 0.0 || !frame.receivers_in_view.iter().all(above) {
+    if !frame.receivers_in_view.iter().all(above) {
         return far;
     }
+    ReceiverBound { ground: Some(plane), ..far }
+}
+
+/// The ground plane as [`ReceiverBound::ground`] takes it, where the light lies above it.
+fn ground_plane(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> Option<Vec3> {
+    let height = frustum.centre().y - frame.scene.ground?.height;
     // 1/r along the ray (x/z, y/z, 1): its world y per unit depth (the view's rows are the
     // light's axes; glsl/smoothie/depth.glsl's ground_depth) over the plane's, −height.
-    ReceiverBound { ground: Some(frustum.view.y_axis.truncate() / -height), ..far }
+    (height > 0.0).then(|| frustum.view.y_axis.truncate() / -height)
 }
 
 /// Where a caster's bounds lie in the light view: their tangent window and depth range, which
@@ -776,11 +782,12 @@ fn casters_meet(casters: &[CasterExtent], size: SmoothieSize, receivers: Receive
 
 /// An estimate of the narrowest smoothie of `casters` (each its window and the deepest point a
 /// smoothie of it starts from: its deepest silhouette vertex, or its bounds' deepest point,
-/// which lies no nearer), in tangent units: each caster's at that point, where t = R/b is least and so is the part 1 − b/r its
-/// receivers can need of it (as [`smoothies`] cuts it); the least of them. Partial silhouettes
-/// do not count: one is drawn only where it reaches further than the silhouette's
-/// ([`partial_smoothies`]). Its receivers' own penumbrae are narrower still where they lie in
-/// front of the ground (a caster on another): those receivers then get the coarser grid.
+/// which lies no nearer), in tangent units: each caster's at that point, where t = R/b is least
+/// and so is the part 1 − b/r of it that `receivers` (the ground) can need; the least of them.
+/// Partial silhouettes do not count: one is drawn only where it reaches further than the
+/// silhouette's ([`partial_smoothies`]). Its receivers' own penumbrae are narrower still where
+/// they lie in front of the ground (a caster on another): those receivers then get the coarser
+/// grid.
 fn narrowest_smoothie(
     casters: impl Iterator<Item = ([f32; 4], f32)>,
     size: SmoothieSize,
