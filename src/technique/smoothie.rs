@@ -209,7 +209,7 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// its alpha is linear, which the resolve's bilinear lookup holds exactly on any grid, and what
 /// a texel costs is where the map's hard edge lies, a texel of which moves V by about 1/texels
 /// of the penumbra. The narrowest is estimated at each caster's deepest silhouette vertex
-/// ([`narrowest_smoothie`]), on the ground behind it.
+/// ([`narrowest_smoothie`]), on the farthest ground over the caster's window.
 ///
 /// 8 texels, from what a halving costs (examples/grid_texels.rs, docs/grid_texels.png: plate
 /// and sphere under lights of ¼ to 2× their radius, fixed grids of 1024², 512² and 256² against
