@@ -660,9 +660,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
                     let title = format!("{name}: {technique} {setting}");
                     trace.cpu_slice(title.trim_end(), started, std::time::Instant::now(), label);
                 }
-                if !offline {
-                    round_ms[i].push(total_median(&timings));
-                }
+                round_ms[i].push(total_median(&timings));
                 measured[i].extend(timings);
                 if capture.is_some() {
                     captures[i] = capture;

@@ -89,7 +89,6 @@ impl TimingReport {
     }
 }
 
-/// Nearest-rank percentile; 0 for no samples.
 /// Each frame's GPU ms, its passes summed.
 fn frame_totals(frames: &[FrameTimings]) -> Vec<f64> {
     frames.iter().map(|f| f.passes.iter().map(|p| p.ms).sum()).collect()
@@ -100,6 +99,7 @@ pub fn total_median(frames: &[FrameTimings]) -> f64 {
     percentile(&frame_totals(frames), 0.5)
 }
 
+/// Nearest-rank percentile; 0 for no samples.
 pub(crate) fn percentile(values: &[f64], q: f64) -> f64 {
     if values.is_empty() {
         return 0.0;
