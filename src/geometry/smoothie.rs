@@ -157,6 +157,16 @@ impl SmoothieGeometry {
         self
     }
 
+    /// The box of every vertex in the light view's tangent plane, [min x, min y, max x, max y]:
+    /// the smoothies and the silhouette they start from; none without a vertex.
+    pub fn window(&self) -> Option<[f32; 4]> {
+        let mut vertices = self.vertices().map(|v| [v.x, v.y]).peekable();
+        vertices.peek()?;
+        Some(vertices.fold([f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY], |w, [x, y]| {
+            [w[0].min(x), w[1].min(y), w[2].max(x), w[3].max(y)]
+        }))
+    }
+
     /// Every vertex, in drawing order: the outer smoothies' ([`Self::outer_vertices`] of them),
     /// then the inner quads'.
     pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
@@ -526,6 +536,12 @@ mod tests {
                 prop_assert!((p - c - shape * t).length() < 1e-5 * (1.0 + t), "radial alpha: shape = offset / t");
                 prop_assert!(shape.x * c.x >= -1e-6 && shape.y * c.y >= -1e-6, "only the gap outside the turn");
             }
+            // Their box: the outline grown by t, which holds the map's footprint of the plate.
+            let w = g.window().expect("smoothies");
+            let rim = half + t;
+            let close = w.iter().zip([-rim, -rim, rim, rim]).all(|(a, b)| (a - b).abs() < 1e-4 * (1.0 + rim));
+            prop_assert!(close, "{:?} against ±{}", w, rim);
+            prop_assert_eq!(SmoothieGeometry::default().window(), None);
             // The gap's disk: every point within t of a corner, outside both edges' quads, is
             // covered by that corner's triangles.
             for tri in g.corners.chunks(3) {

@@ -507,22 +507,27 @@ impl Smoothie {
     }
 
     /// The smoothies of every caster ([`Self::find_silhouettes`]) through this frame's light
-    /// view.
+    /// view, and where each caster's lie for [`casters_meet`]: their box
+    /// ([`SmoothieGeometry::window`], which holds the caster's outline in the map too, the
+    /// silhouette they start from, within the merge `tolerance`), everywhere for a caster
+    /// reaching the light's plane (its outline is unbounded), none for one without smoothies.
     fn geometry(
         &self,
         frame: &FrameInputs<'_>,
         cast: &[Option<Arc<Mesh>>],
-        view: &Mat4,
+        frustum: &LightFrustum,
         (size, receivers): (SmoothieSize, ReceiverBound),
         (centred, tolerance): (bool, f32),
-    ) -> SmoothieGeometry {
+    ) -> (SmoothieGeometry, Vec<[f32; 4]>) {
         let mut out = SmoothieGeometry::default();
+        let mut windows = Vec::new();
         let casters = frame.scene.objects.iter().zip(cast).zip(&self.silhouettes);
         // Casters numbered as the compute path numbers them: those that cast, in order.
         let casting = casters.filter_map(|((o, mesh), c)| Some((o, mesh.as_ref()?, c.as_ref().expect("found"))));
         for (number, (o, mesh, c)) in (1..).zip(casting) {
             let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
-            let view = *view * o.transform.matrix();
+            let model = o.transform.matrix();
+            let view = frustum.view * model;
             let penumbra = penumbra(centred, &view, &mesh.bounds);
             let mut geometry = if tolerance > 0.0 {
                 let merged = merged_silhouette(&view, &caster, &c.edges, (size, receivers), tolerance);
@@ -531,9 +536,14 @@ impl Smoothie {
                 smoothies(&view, &caster, &c.edges, (size, receivers), penumbra)
             };
             geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, receivers)));
+            if !frustum.window_of(&mesh.bounds.transformed(&model)).iter().all(|v| v.is_finite()) {
+                windows.push(EVERYWHERE);
+            } else if let Some([x0, y0, x1, y1]) = geometry.window() {
+                windows.push([x0 - tolerance, y0 - tolerance, x1 + tolerance, y1 + tolerance]);
+            }
             out.extend(&geometry.in_channel(number));
         }
-        out
+        (out, windows)
     }
 }
 
@@ -573,8 +583,10 @@ impl Technique for Smoothie {
         }
         let [x0, y0, x1, y1] = frustum.window;
         let window = (x1 - x0).max(y1 - y0);
-        let extents: Vec<CasterExtent> = bounds.iter().map(|b| CasterExtent::new(&frustum, b)).collect();
         let gpu_silhouettes = params.is_on(&GPU_SILHOUETTES);
+        // What the compute path knows of its casters before the GPU finds their silhouettes.
+        let extents: Vec<CasterExtent> =
+            if gpu_silhouettes { bounds.iter().map(|b| CasterExtent::new(&frustum, b)).collect() } else { Vec::new() };
         if !gpu_silhouettes {
             self.find_silhouettes(frame, &cast, centred);
         }
@@ -623,8 +635,9 @@ impl Technique for Smoothie {
         let biases = [depth_bias + stray, slope_bias + stray, normal_offset];
         self.pass.record(frame, &frustum, size, biases, kernel, Some(&self.casters))?;
 
-        // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path).
-        let source = if gpu_silhouettes {
+        // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path), and
+        // where each caster's lie ([`casters_meet`]).
+        let (source, windows) = if gpu_silhouettes {
             if self.gpu.is_none() {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
             }
@@ -632,15 +645,17 @@ impl Technique for Smoothie {
             let radius = frame.scene.light.radius;
             let (vertices, args) =
                 gpu.record(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, radius))?;
-            Smoothies::Indirect { vertices, args }
+            let windows = extents.iter().map(|c| c.reach(smoothie_size, receivers)).collect();
+            (Smoothies::Indirect { vertices, args }, windows)
         } else {
             // The merge bound in tangent units: texels of the smoothie buffer over the window.
             let [x0, y0, x1, y1] = frustum.window;
             let tolerance = params.get(&MERGE) as f32 * (x1 - x0).max(y1 - y0) / buffer_size as f32;
-            let geometry = self.geometry(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, tolerance));
+            let (geometry, windows) =
+                self.geometry(frame, &cast, &frustum, (smoothie_size, receivers), (centred, tolerance));
             let vertices: Vec<SmoothieVertex> = geometry.vertices().copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
-            if bytes.is_empty() {
+            let source = if bytes.is_empty() {
                 Smoothies::None
             } else {
                 let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
@@ -648,11 +663,13 @@ impl Technique for Smoothie {
                 v.write(frame.slot, bytes);
                 let outer = geometry.outer_vertices() as u32;
                 Smoothies::Direct { vertices: v.range(frame.slot), outer, inner: vertices.len() as u32 - outer }
-            }
+            };
+            (source, windows)
         };
 
-        let texel = window / buffer_size as f32;
-        let layout = Buffer::new(centred, casters_meet(&extents, smoothie_size, receivers, texel));
+        // Two texels of the coarser grid: an inner quad's probe looks 1.5 map texels outside.
+        let texel = window / buffer_size.min(size) as f32;
+        let layout = Buffer::new(centred, casters_meet(&windows, 2.0 * texel));
         let formats = &self.buffer_formats[layout as usize];
         for ((target, &format), name) in
             self.buffer.iter_mut().zip(formats).zip(["smoothie buffer", "inner smoothies", "odd smoothies"])
@@ -745,7 +762,7 @@ fn ground_plane(frame: &FrameInputs<'_>, frustum: &LightFrustum) -> Option<Vec3>
 }
 
 /// Where a caster's bounds lie in the light view: their tangent window and depth range, which
-/// [`casters_meet`] takes, and the compute path's [`narrowest_smoothie`].
+/// the compute path takes for [`casters_meet`] and [`narrowest_smoothie`].
 struct CasterExtent {
     window: [f32; 4],
     near: f32,
@@ -757,27 +774,40 @@ impl CasterExtent {
         let (near, deepest) = depth_range(&frustum.view, bounds);
         CasterExtent { window: frustum.window_of(bounds), near, deepest }
     }
+
+    /// Where its smoothies can lie, for [`casters_meet`] on the compute path, which makes them
+    /// on the GPU: its window grown by the farthest they reach, everywhere for a caster
+    /// reaching the light's plane.
+    fn reach(&self, size: SmoothieSize, receivers: ReceiverBound) -> [f32; 4] {
+        let pad = size.largest_reach(self.near, self.window, receivers);
+        let [x0, y0, x1, y1] = self.window;
+        let grown = [x0 - pad, y0 - pad, x1 + pad, y1 + pad];
+        if grown.iter().all(|v| v.is_finite()) { grown } else { EVERYWHERE }
+    }
 }
+
+/// A window that meets every other.
+const EVERYWHERE: [f32; 4] = [f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY];
 
 /// Whether two casters' smoothies can meet in the buffer, or one's inner quads probe the other
 /// just outside its edge (glsl/smoothie/centred.glsl): only then do they need the channels of
 /// [`Buffer::Channels`]. Casters apart, one caster's buffer holds them all as well, a target
 /// fewer (overlap's two plates moved about 3 m further apart, 512², lavapipe, three interleaved
 /// runs: the smoothie pass 5.5–6.7 → 4.4–5.5 ms, the resolve 11.9–15.6 → 10.4–14.4, V the same
-/// within 1e-4). Each caster's window, grown by its smoothies' reach and two texels, against every
-/// other's: boxes, so a caster whose box reaches another's gets channels all the same.
-fn casters_meet(casters: &[CasterExtent], size: SmoothieSize, receivers: ReceiverBound, texel: f32) -> bool {
-    let everywhere = [f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY];
-    let covered = |&CasterExtent { window, near, .. }: &CasterExtent| {
-        let pad = size.largest_reach(near, window, receivers) + 2.0 * texel;
-        let [x0, y0, x1, y1] = window;
-        let grown = [x0 - pad, y0 - pad, x1 + pad, y1 + pad];
-        // A caster reaching the light's plane covers everything.
-        if grown.iter().all(|v| v.is_finite()) { grown } else { everywhere }
-    };
-    let windows: Vec<[f32; 4]> = casters.iter().map(covered).collect();
+/// within 1e-4). `windows`: where each caster's smoothies and outline lie (tangent boxes), each
+/// grown by `pad` against every other's.
+///
+/// The CPU path gives the boxes of the smoothies it made ([`Smoothie::geometry`]), the compute
+/// path its casters' bounds grown by the smoothies' reach ([`CasterExtent::reach`]): a bounds'
+/// box reaches well past its silhouette's smoothies. On `default` every caster's grown bounds
+/// met another's, none of their smoothies' boxes did, and the one-caster buffer took the
+/// smoothie pass from 5.3–6.5 to 4.2–5.0 ms and the resolve from 9.9–14.0 to 8.2–10.5 (512²,
+/// lavapipe, four interleaved runs of 40 frames), V the same within 6e-4 (the channel bit).
+fn casters_meet(windows: &[[f32; 4]], pad: f32) -> bool {
+    let grown: Vec<[f32; 4]> =
+        windows.iter().map(|&[x0, y0, x1, y1]| [x0 - pad, y0 - pad, x1 + pad, y1 + pad]).collect();
     let meet = |a: &[f32; 4], b: &[f32; 4]| a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
-    windows.iter().enumerate().any(|(i, a)| windows[i + 1..].iter().any(|b| meet(a, b)))
+    grown.iter().enumerate().any(|(i, a)| grown[i + 1..].iter().any(|b| meet(a, b)))
 }
 
 /// An estimate of the narrowest smoothie of `casters` (each its window and the deepest point a
@@ -882,8 +912,8 @@ mod tests {
             let frustum = fit_spot_frustum(light, None, &casters, &ground).frustum.expect("in view");
             // The ground's plane bounds the receivers (receiver_bound), 8 below the light.
             let ground = Some(frustum.view.y_axis.truncate() / -8.0);
-            let extents = casters.map(|b| CasterExtent::new(&frustum, &b));
-            casters_meet(&extents, size, ReceiverBound { far: frustum.far, ground }, 1e-3)
+            let receivers = ReceiverBound { far: frustum.far, ground };
+            casters_meet(&casters.map(|b| CasterExtent::new(&frustum, &b).reach(size, receivers)), 2e-3)
         };
         // Each plate's smoothies reach R (1 − b/r) = 0.5 (1 − 7/8) ≈ 0.06 m beyond it on the
         // ground, and two texels, 0.014 m: plates nearer than 0.15 m meet, plates further apart
@@ -896,7 +926,7 @@ mod tests {
         // A caster reaching the light's plane covers every direction.
         let casters = [still, Aabb { min: Vec3::new(3.0, 7.0, -0.3), max: Vec3::new(3.6, 9.0, 0.3) }];
         let frustum = fit_spot_frustum(light, None, &casters[..1], &ground).frustum.expect("in view");
-        let extents = casters.map(|b| CasterExtent::new(&frustum, &b));
-        assert!(casters_meet(&extents, size, ReceiverBound::up_to(frustum.far), 1e-3));
+        let reach = casters.map(|b| CasterExtent::new(&frustum, &b).reach(size, ReceiverBound::up_to(frustum.far)));
+        assert!(casters_meet(&reach, 2e-3));
     }
 }
