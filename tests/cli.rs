@@ -198,6 +198,13 @@ fn bench_quick_writes_results_a_report_and_a_plot() {
     assert!(header.contains(&"technique") && header.contains(&"gpu_ms_total_median"));
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 6, "two scenes x three techniques");
+    // Each row's round medians, one per round of its frames (3 frames: three rounds of one).
+    let rounds = header.iter().position(|h| *h == "round_ms").unwrap();
+    for row in &rows {
+        let cells: Vec<&str> = row.split(',').collect();
+        let ms: Vec<f64> = cells[rounds].trim_matches('"').split(' ').map(|v| v.parse().unwrap()).collect();
+        assert!(ms.len() == 3 && ms.iter().all(|&v| v > 0.0), "{row}");
+    }
     // In each scene the most accurate row (penumbra RMSE) is Pareto-optimal.
     let pareto = header.iter().position(|h| *h == "pareto").unwrap();
     let error = header.iter().position(|h| *h == "penumbra_rmse").unwrap();

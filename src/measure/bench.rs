@@ -289,15 +289,16 @@ pub fn mark_pareto(rows: &mut [BenchRow]) {
 pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
     let mut out = String::from(
         "scene,technique,setting,gpu_ms_total_median,gpu_ms_total_p95,cpu_ms_median,cpu_ms_technique,rmse,mae,max_abs,p99_abs,\
-         penumbra_rmse,leak_rate,dark_rate,mean_bias,pixels,excluded,pareto,passes\n",
+         penumbra_rmse,leak_rate,dark_rate,mean_bias,pixels,excluded,pareto,passes,round_ms\n",
     );
     for r in rows {
         let m = &r.metrics;
         let passes: Vec<String> =
             r.timings.passes.iter().map(|p| format!("{}={:.3}", p.name, p.gpu_ms_median)).collect();
+        let rounds: Vec<String> = r.round_ms.iter().map(|ms| format!("{ms:.3}")).collect();
         let _ = writeln!(
             out,
-            "{},{},\"{}\",{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{},{},\"{}\"",
+            "{},{},\"{}\",{:.4},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{:.5},{},{},{},\"{}\",\"{}\"",
             r.scene,
             r.technique,
             r.setting,
@@ -316,7 +317,8 @@ pub fn write_csv(rows: &[BenchRow], path: &Path) -> Result<()> {
             m.pixels,
             m.excluded,
             r.pareto,
-            passes.join(" ")
+            passes.join(" "),
+            rounds.join(" ")
         );
     }
     std::fs::write(path, out).map_err(|error| Error::Io { path: path.into(), error })
