@@ -1,4 +1,4 @@
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 /// An axis-aligned box; `min > max` on some axis means empty.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,4 +40,12 @@ impl Aabb {
     pub fn transformed(&self, m: &Mat4) -> Aabb {
         Aabb::from_points(self.corners().map(|c| m.transform_point3(c)))
     }
+}
+
+/// Whether any two of `boxes` (2D, min and max corners), each grown by `pad` on every side,
+/// overlap: what decides whether several casters' shadows need to be kept apart.
+pub fn any_two_meet(boxes: &[(Vec2, Vec2)], pad: f32) -> bool {
+    let meet =
+        |a: &(Vec2, Vec2), b: &(Vec2, Vec2)| (a.0 - pad).cmple(b.1 + pad).all() && (b.0 - pad).cmple(a.1 + pad).all();
+    boxes.iter().enumerate().any(|(i, a)| boxes[i + 1..].iter().any(|b| meet(a, b)))
 }

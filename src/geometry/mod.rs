@@ -16,7 +16,7 @@ pub mod silhouette;
 pub mod smoothie;
 
 pub use adjacency::{Edge, EdgeAdjacency, NO_FACE};
-pub use bounds::Aabb;
+pub use bounds::{Aabb, any_two_meet};
 pub use clip::{Hexahedron, intersection_points};
 pub use light_frustum::{LightFrustum, SpotFit, fit_spot_frustum, nearer_light};
 pub use light_samples::{Cap, LightPoint, light_points, point_like, visible_cap};

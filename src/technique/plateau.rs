@@ -98,6 +98,7 @@ use super::{Technique, clear_visibility, nearer_light, refuse_wide_lights, resol
 use crate::error::Result;
 use crate::frame::interface::PlateauView;
 use crate::frame::{FrameInputs, MESH_POSITIONS};
+use crate::geometry::any_two_meet;
 use crate::geometry::plateau::{
     Penumbra, PenumbraSize, PlateauGeometry, PlateauLight, ReceiverPlane, Sheet, caster_sides,
 };
@@ -642,12 +643,9 @@ const MASK_PROBE: f32 = 2.0;
 /// (512², lavapipe, four interleaved runs of 40 frames). Every multi-caster scene of the suite
 /// has shadows that meet, `default`'s too.
 fn footprints_meet<'a>(casters: impl Iterator<Item = &'a PlateauGeometry>, probe: f32) -> bool {
-    let boxes: Vec<(Vec2, Vec2)> = casters
-        .filter_map(|g| if g.unbounded { Some((Vec2::MIN, Vec2::MAX)) } else { g.footprint })
-        .map(|(lo, hi)| (lo - probe, hi + probe))
-        .collect();
-    let meet = |a: &(Vec2, Vec2), b: &(Vec2, Vec2)| a.0.cmple(b.1).all() && b.0.cmple(a.1).all();
-    boxes.iter().enumerate().any(|(i, a)| boxes[i + 1..].iter().any(|b| meet(a, b)))
+    let boxes: Vec<(Vec2, Vec2)> =
+        casters.filter_map(|g| if g.unbounded { Some((Vec2::MIN, Vec2::MAX)) } else { g.footprint }).collect();
+    any_two_meet(&boxes, probe)
 }
 
 #[cfg(test)]

@@ -71,7 +71,7 @@ use std::sync::Arc;
 
 use ash::vk;
 use bytemuck::cast_slice;
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::falloff::{FALLOFF, PENUMBRA};
 use super::grid::{self, Halving};
@@ -88,7 +88,7 @@ use crate::geometry::smoothie::{
     Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette,
     merged_smoothies, partial_smoothies, smoothies,
 };
-use crate::geometry::{Aabb, LightFrustum};
+use crate::geometry::{Aabb, LightFrustum, any_two_meet};
 use crate::gpu::{
     Access, Attachment, Blend, Context, DRAW_COMMAND_BYTES, DepthState, Descriptor, Guard, PerFrame, Pipeline,
     PipelineDesc, RenderPass, Target, TargetDesc, Variants, VertexInput, draw_fullscreen, draw_indirect, draw_vertices,
@@ -804,10 +804,9 @@ const EVERYWHERE: [f32; 4] = [f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINIT
 /// smoothie pass from 5.3–6.5 to 4.2–5.0 ms and the resolve from 9.9–14.0 to 8.2–10.5 (512²,
 /// lavapipe, four interleaved runs of 40 frames), V the same within 6e-4 (the channel bit).
 fn casters_meet(windows: &[[f32; 4]], pad: f32) -> bool {
-    let grown: Vec<[f32; 4]> =
-        windows.iter().map(|&[x0, y0, x1, y1]| [x0 - pad, y0 - pad, x1 + pad, y1 + pad]).collect();
-    let meet = |a: &[f32; 4], b: &[f32; 4]| a[0] <= b[2] && b[0] <= a[2] && a[1] <= b[3] && b[1] <= a[3];
-    grown.iter().enumerate().any(|(i, a)| grown[i + 1..].iter().any(|b| meet(a, b)))
+    let boxes: Vec<(Vec2, Vec2)> =
+        windows.iter().map(|&[x0, y0, x1, y1]| (Vec2::new(x0, y0), Vec2::new(x1, y1))).collect();
+    any_two_meet(&boxes, pad)
 }
 
 /// An estimate of the narrowest smoothie of `casters` (each its window and the deepest point a
