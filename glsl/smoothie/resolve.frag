@@ -42,6 +42,7 @@ layout(location = 0) out float out_visibility;
 // The four smoothie texels around a lookup, in gather order (i0,j1) (i1,j1) (i1,j0) (i0,j0),
 // a gather per channel.
 struct Texels {
+    float code;      // the receiver's depth code
     ivec2 base;      // texel (i0, j0)
     vec2 f;          // bilinear weights
     vec4 b;          // the nearest outer smoothies' depth codes
@@ -51,6 +52,7 @@ struct Texels {
     vec4 inner_odd;  // centred: 1 where the inner quad is an odd caster's
     vec4 inner_b;    // centred: the inner quads' depth codes
     vec4 behind;     // 1 where the receiver lies behind the texel's outer smoothie
+    vec4 apart;      // and that smoothie is another blocker's, not the receiver's own silhouette
 };
 
 // How far past an inner quad's limit a receiver still counts as the surface there, in depth
@@ -69,6 +71,7 @@ vec2 smoothie_pos(vec2 uv) {
 Texels texels(vec2 uv, float depth) {
     float code = depth_code(light, depth);
     Texels t;
+    t.code = code;
     vec2 pos = smoothie_pos(uv);
     t.base = ivec2(pos);
     t.f = fract(pos);
@@ -91,6 +94,9 @@ Texels texels(vec2 uv, float depth) {
         t.inner = mix(vec4(coded >> 1u) / 32767.0, vec4(1.0), greaterThan(vec4(code), limit + LIMIT_SLACK));
     }
     t.behind = vec4(greaterThan(vec4(code), t.b));
+    // Its own silhouette's outer smoothie reaches a receiver only across the bilinear texel,
+    // and there at contact (b/r → 1, as at a terminator): within the limits' slack.
+    t.apart = t.behind * vec4(lessThan(t.b, vec4(code - LIMIT_SLACK)));
     return t;
 }
 
@@ -98,20 +104,39 @@ float min4(vec4 v) {
     return min(min(v.x, v.y), min(v.z, v.w));
 }
 
-// The paper's smoothie test: α' where the receiver lies behind a smoothie, else 1.
-float outer_test(vec2 uv, float depth) {
+// The paper's smoothie test: α' where the receiver lies behind a smoothie, else 1; second, the
+// same from other blockers' smoothies alone (with_own_plane).
+vec2 outer_test(vec2 uv, float depth) {
     Texels t = texels(uv, depth);
-    return bilinear(t.f, mix(vec4(1.0), t.outer, t.behind));
+    return vec2(bilinear(t.f, mix(vec4(1.0), t.outer, t.behind)), bilinear(t.f, mix(vec4(1.0), t.outer, t.apart)));
+}
+
+// V from each texel's lit-side factors (`lit_even`, `lit_odd`) and inner halves (`inner`), the
+// inner half in its caster's channel, the two channels' visibilities multiplied (centred_test).
+float channels(Texels t, vec4 lit_even, vec4 lit_odd, vec4 inner, vec4 deep) {
+    vec4 even = lit_even * mix(inner, vec4(1.0), t.inner_odd);
+    vec4 odd = lit_odd * mix(vec4(1.0), inner, t.inner_odd);
+    // Umbra texels (a = 1, most of them beyond any inner quad, which would put them in the odd
+    // channel) join the channel of the penumbra beside them, the darker among the other
+    // texels, so a penumbra runs into its umbra within one channel, as with one. Left in the
+    // odd channel, an even caster's penumbra interpolated toward a lit odd channel there
+    // (overlap: 32 px more leaks); made umbra in both, they dimmed the other channel over
+    // inner halves a texel or two wide (wingnut, near contact: penumbra RMSE 0.018 → 0.023).
+    float odd_beside = float(min4(mix(odd, vec4(1.0), deep)) <= min4(mix(even, vec4(1.0), deep)));
+    even = mix(even, lit_even * odd_beside, deep);
+    odd = mix(odd, lit_odd * (1.0 - odd_beside), deep);
+    return falloff_at(bilinear(t.f, even)) * falloff_at(bilinear(t.f, odd));
 }
 
 // Centred V: the penumbra parameter, 0 umbra .. ½ hard edge .. 1 lit, through the falloff;
 // `umbra`, the hard test, where no smoothie is near (exactly the hard shadow for a point light).
+// Second, V from other blockers alone, the receiver's own silhouette left out (with_own_plane).
 // `map`: the shadow map's texels around the lookup, which are the smoothie texels' own where
 // the two grids agree (SAME_GRID).
-float centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
+vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     Texels t = texels(uv, depth);
     if (t.behind == vec4(0.0) && t.inner == vec4(1.0)) {
-        return umbra;
+        return vec2(umbra, 1.0);
     }
     // Equation 1 for the inner half, r the receiver's depth (contact, b ≥ r: hard).
     vec4 a = clamp(t.inner / max(1.0 - min(code_depth(light, t.inner_b) / depth, vec4(1.0)), 1e-6), 0.0, 1.0);
@@ -138,19 +163,14 @@ float centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     vec4 lit_even = 0.5 + 0.5 * mix(vec4(1.0), t.outer, mix(t.behind, in_front + in_back * t.inner_odd, shadowed));
     vec4 lit_odd = 0.5 + 0.5 * mix(vec4(1.0), t.outer_odd, mix(t.behind, in_front + in_back * (1.0 - t.inner_odd), shadowed));
     vec4 inner = mix(vec4(1.0), 0.5 - 0.5 * a, shadowed);
-    // Umbra texels (a = 1, most of them beyond any inner quad, which would put them in the odd
-    // channel) join the channel of the penumbra beside them, the darker among the other
-    // texels, so a penumbra runs into its umbra within one channel, as with one. Left in the
-    // odd channel, an even caster's penumbra interpolated toward a lit odd channel there
-    // (overlap: 32 px more leaks); made umbra in both, they dimmed the other channel over
-    // inner halves a texel or two wide (wingnut, near contact: penumbra RMSE 0.018 → 0.023).
     vec4 deep = shadowed * vec4(greaterThanEqual(a, vec4(1.0)));
-    vec4 even = lit_even * mix(inner, vec4(1.0), t.inner_odd);
-    vec4 odd = lit_odd * mix(vec4(1.0), inner, t.inner_odd);
-    float odd_beside = float(min4(mix(odd, vec4(1.0), deep)) <= min4(mix(even, vec4(1.0), deep)));
-    even = mix(even, lit_even * odd_beside, deep);
-    odd = mix(odd, lit_odd * (1.0 - odd_beside), deep);
-    return falloff_at(bilinear(t.f, even)) * falloff_at(bilinear(t.f, odd));
+    vec4 apart_even = 0.5 + 0.5 * mix(vec4(1.0), t.outer, mix(t.apart, in_front + in_back * t.inner_odd, shadowed));
+    vec4 apart_odd = 0.5 + 0.5 * mix(vec4(1.0), t.outer_odd, mix(t.apart, in_front + in_back * (1.0 - t.inner_odd), shadowed));
+    // An inner quad at the receiver's own depth (within the limits' slack) is its own silhouette:
+    // the terminator, which with_own_plane leaves to the tangent plane.
+    vec4 own = shadowed * vec4(greaterThanEqual(t.inner_b, vec4(t.code - LIMIT_SLACK)));
+    return vec2(channels(t, lit_even, lit_odd, inner, deep),
+                channels(t, apart_even, apart_odd, mix(inner, vec4(1.0), own), deep * (1.0 - own)));
 }
 
 // Whether V at this lookup can differ from the hard test's: an alpha below 1 among the four
@@ -172,6 +192,25 @@ bool near_smoothie(vec2 uv, float umbra) {
     return edge || any(lessThan(textureGather(smoothies, corner, 1), vec4(1.0)));
 }
 
+// The falloff where the penumbra is, 0 and 1 kept exact (the hard shadow of a point light).
+float penumbra_curve(float v) {
+    return v > 0.0 && v < 1.0 ? falloff_at(v) : v;
+}
+
+// V of a caster's own surface, from `self_lit`, the part of the light in front of its tangent
+// plane, the shadow test's `v`, and `others`, the same test with the receiver's own
+// silhouette left out (its smoothies at the receiver's depth: contact, as at a terminator).
+// Another blocker's edge cuts the light's disk apart from the plane: the product, as blockers
+// in two channels combine (exact for an edge square to the plane through the light's centre).
+// The receiver's own silhouette is its terminator, whose map edge hides what the plane hides:
+// the darker of the two, not their product, which counts it twice (the sphere's terminator).
+// The darker of the plane and every blocker, as before, held a face the light grazes at the
+// plane's V under another caster's penumbra: default's wingnut at 0.66 under its own wing,
+// where the truth falls to 0.3 (leaks there: 307 px of 512², 211 with the product).
+float with_own_plane(float self_lit, float v, float others) {
+    return others * min(self_lit, v / max(others, 1e-6));
+}
+
 void main() {
     Surface s = read_surface(frame, camera_depth, camera_normal, in_uv);
     if (!s.receives) {
@@ -180,9 +219,7 @@ void main() {
     }
     // A caster's own surface hides the part of the light behind its tangent plane: the soft
     // terminator of an area light (exact for a convex caster), where the hard test at the
-    // light's centre put most of the centred smoothie's remaining error on the casters. Past
-    // the terminator the map and the caster's own smoothies see the same blocker, so the two
-    // combine by the darker, not multiplied (which counts it twice).
+    // light's centre put most of the centred smoothie's remaining error on the casters.
     float self_lit = in_front_of_itself(s, frame.light.xyz, frame.light.w);
     if (self_lit == 0.0) {
         out_visibility = 0.0;
@@ -205,9 +242,11 @@ void main() {
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
     // curve.
     if (CENTRED) {
-        out_visibility = min(self_lit, centred_test(l.uv, l.depth, umbra, map));
+        vec2 v = centred_test(l.uv, l.depth, umbra, map);
+        out_visibility = with_own_plane(self_lit, v.x, v.y);
         return;
     }
-    float v = umbra > 0.0 ? min(umbra, outer_test(l.uv, l.depth)) : 0.0;
-    out_visibility = min(self_lit, v > 0.0 && v < 1.0 ? falloff_at(v) : v);
+    vec2 outer = outer_test(l.uv, l.depth);
+    float v = umbra > 0.0 ? min(umbra, outer.x) : 0.0;
+    out_visibility = with_own_plane(self_lit, penumbra_curve(v), penumbra_curve(outer.y));
 }
