@@ -97,6 +97,22 @@ fn techniques_lists_knobs_with_defaults() {
     );
 }
 
+/// Standard output closed before the first line (`softshadow techniques | head -0`): the program
+/// ends as a filter does, with no panic.
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    let mut child = softshadow()
+        .arg("techniques")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.is_empty(), "{:?}: {err}", out.status);
+}
+
 #[test]
 fn compare_prints_metrics_as_json_and_writes_a_difference_image() {
     let diff = std::env::temp_dir().join(format!("softshadow-diff-{}.png", std::process::id()));

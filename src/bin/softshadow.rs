@@ -1,5 +1,13 @@
 //! The `softshadow` command line (DESIGN.md §3).
 
+/// `println!` that ends the program quietly when standard output is a closed pipe
+/// (`softshadow techniques | head`), as a Unix filter does, where `println!` panics.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::write_line(format_args!($($arg)*))
+    };
+}
+
 #[path = "softshadow/view.rs"]
 mod view;
 
@@ -152,6 +160,17 @@ struct ShowcaseArgs {
     height: Option<u32>,
 }
 
+fn write_line(line: std::fmt::Arguments) {
+    use std::io::Write as _;
+    if let Err(e) = writeln!(std::io::stdout().lock(), "{line}") {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            eprintln!("softshadow: writing to standard output: {e}");
+            std::process::exit(1);
+        }
+        std::process::exit(0);
+    }
+}
+
 fn main() {
     if let Err(e) = run(Cli::parse()) {
         eprintln!("softshadow: {e:#}");
@@ -168,9 +187,9 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::View(args)) => view::view(&args),
         Some(Command::Techniques) => {
             for t in TECHNIQUES {
-                println!("{}: {}", t.name, t.summary);
+                out!("{}: {}", t.name, t.summary);
                 for k in t.knobs {
-                    println!("    {:<16} default {:<8} range {}..={}  {}", k.name, k.default, k.min, k.max, k.help);
+                    out!("    {:<16} default {:<8} range {}..={}  {}", k.name, k.default, k.min, k.max, k.help);
                 }
             }
             Ok(())
@@ -178,12 +197,12 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Info) => {
             let engine = Engine::headless(&ContextOptions::from_env())?;
             let d = engine.device();
-            println!("device:   {} ({})", d.name, d.device_type);
-            println!("driver:   {}", d.driver);
-            println!("vulkan:   {}", d.vulkan_version);
-            println!("max 2D image side:    {}", d.max_image_dimension_2d);
-            println!("max push constants:   {} bytes", d.max_push_constants_size);
-            println!("timestamp period:     {} ns, {} valid bits", d.timestamp_period_ns, d.timestamp_valid_bits);
+            out!("device:   {} ({})", d.name, d.device_type);
+            out!("driver:   {}", d.driver);
+            out!("vulkan:   {}", d.vulkan_version);
+            out!("max 2D image side:    {}", d.max_image_dimension_2d);
+            out!("max push constants:   {} bytes", d.max_push_constants_size);
+            out!("timestamp period:     {} ns, {} valid bits", d.timestamp_period_ns, d.timestamp_valid_bits);
             Ok(())
         }
         None => showcase(&ShowcaseArgs::parse_from(["softshadow showcase"])),
@@ -249,7 +268,7 @@ fn showcase(args: &ShowcaseArgs) -> Result<()> {
     contact_sheet(&tiles, 4, &sheet)?;
 
     let first = &rows[0].2;
-    println!(
+    out!(
         "{}, {}x{}, {} ({}); GPU and CPU ms: medians of 20 frames after 3 warm-up (offline techniques: 1 frame); \
          error against {} [{}]",
         args.scene.display(),
@@ -260,18 +279,24 @@ fn showcase(args: &ShowcaseArgs) -> Result<()> {
         truth_info.name,
         truth_settings.params
     );
-    println!(
+    out!(
         "{:<12} {:>10} {:>10} {:>9} {:>10} {:>9} {:>9}",
-        "technique", "GPU ms", "CPU ms", "RMSE", "penumbra", "leak", "dark"
+        "technique",
+        "GPU ms",
+        "CPU ms",
+        "RMSE",
+        "penumbra",
+        "leak",
+        "dark"
     );
     for (info, _, report, metrics) in &rows {
         let errors = match metrics {
             Some(m) => format!("{:>9.4} {:>10.4} {:>9.4} {:>9.4}", m.rmse, m.penumbra_rmse, m.leak_rate, m.dark_rate),
             None => format!("{:>9}", "(truth)"),
         };
-        println!("{:<12} {:>10.2} {:>10.2} {errors}", info.name, report.gpu_ms_total_median, cpu(report));
+        out!("{:<12} {:>10.2} {:>10.2} {errors}", info.name, report.gpu_ms_total_median, cpu(report));
     }
-    println!(
+    out!(
         "wrote {} and per technique {}/<technique>/{{color,visibility}}.png, timings.json",
         sheet.display(),
         args.out.display()
@@ -442,20 +467,13 @@ fn compare(args: &CompareArgs) -> Result<()> {
             "against_timings": reference_report,
             "metrics": metrics,
         });
-        println!("{}", serde_json::to_string_pretty(&json)?);
+        out!("{}", serde_json::to_string_pretty(&json)?);
         return Ok(());
     }
-    println!("{} [{}] against {} [{}]", report.technique, settings.params, against.name, truth.params);
-    println!(
-        "{}, {}x{}, {} ({})",
-        args.what.scene.display(),
-        report.width,
-        report.height,
-        report.device,
-        report.driver
-    );
-    println!("{:<28} {:>12}", "GPU ms (median)", format!("{:.3}", report.gpu_ms_total_median));
-    println!("{:<28} {:>12}", "reference GPU ms", format!("{:.3}", reference_report.gpu_ms_total_median));
+    out!("{} [{}] against {} [{}]", report.technique, settings.params, against.name, truth.params);
+    out!("{}, {}x{}, {} ({})", args.what.scene.display(), report.width, report.height, report.device, report.driver);
+    out!("{:<28} {:>12}", "GPU ms (median)", format!("{:.3}", report.gpu_ms_total_median));
+    out!("{:<28} {:>12}", "reference GPU ms", format!("{:.3}", reference_report.gpu_ms_total_median));
     let m = &metrics;
     let rows: [(&str, String); 10] = [
         ("receiver pixels compared", m.pixels.to_string()),
@@ -470,7 +488,7 @@ fn compare(args: &CompareArgs) -> Result<()> {
         ("mean bias", format!("{:+.5}", m.mean_bias)),
     ];
     for (name, value) in rows {
-        println!("{name:<28} {value:>12}");
+        out!("{name:<28} {value:>12}");
     }
     Ok(())
 }
@@ -490,12 +508,12 @@ fn extremes(args: &BenchArgs) -> Result<()> {
     finish(engine)?;
     let csv = args.out.join("extremes.csv");
     write_csv(&rows, &csv)?;
-    println!("wrote {} ({} renders)", csv.display(), rows.len());
+    out!("wrote {} ({} renders)", csv.display(), rows.len());
     let problems = problems(&rows);
     if !problems.is_empty() {
         bail!("{} stability problem(s):\n{}", problems.len(), problems.join("\n"));
     }
-    println!("no NaN, V within [0, 1], continuous along every axis");
+    out!("no NaN, V within [0, 1], continuous along every axis");
     Ok(())
 }
 
@@ -532,13 +550,13 @@ fn curve(args: &BenchArgs) -> Result<()> {
             settings.params = Params::defaults(info);
             settings.params.apply(sets.iter().copied())?;
             let (_, timings) = render_frames(&mut engine, &scene, &settings, Some(args.frames), None)?;
-            println!("{triangles} triangles, {}: {:.2} ms", info.name, timings.gpu_ms_total_median);
+            out!("{triangles} triangles, {}: {:.2} ms", info.name, timings.gpu_ms_total_median);
             points.push(CurvePoint { technique: info.name.into(), triangles, gpu_ms: timings.gpu_ms_total_median });
         }
     }
     finish(engine)?;
     write_curve(&points, softshadow::technique::shadow_map::INFO.name, &args.out)?;
-    println!("wrote {0}/curve.csv, {0}/curve.md, {0}/cost_curve.png", args.out.display());
+    out!("wrote {0}/curve.csv, {0}/curve.md, {0}/cost_curve.png", args.out.display());
     Ok(())
 }
 
@@ -689,15 +707,11 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
-    registry_cost_goals()
-        .iter()
-        .chain(&leak_goals())
-        .filter_map(|g| g.outcome(&rows))
-        .for_each(|line| println!("{line}"));
+    registry_cost_goals().iter().chain(&leak_goals()).filter_map(|g| g.outcome(&rows)).for_each(|line| out!("{line}"));
     if let (Some(trace), Some(p)) = (trace, &args.trace) {
         trace.finish()?;
-        println!("wrote {}", p.display());
+        out!("wrote {}", p.display());
     }
-    println!("wrote {0}/results.csv, {0}/report.md, {0}/tradeoff.png", args.out.display());
+    out!("wrote {0}/results.csv, {0}/report.md, {0}/tradeoff.png", args.out.display());
     Ok(())
 }

@@ -199,7 +199,7 @@ pub fn view(args: &ViewArgs) -> Result<()> {
     let mut params = settings.params;
     let mut controls = Controls::new(&scene);
     if args.frames.is_none() {
-        println!("{KEYS}");
+        out!("{KEYS}");
     }
     let mut recent: VecDeque<FrameTimings> = VecDeque::new();
     let mut frame = 0u64;
@@ -234,9 +234,12 @@ pub fn view(args: &ViewArgs) -> Result<()> {
             let stats = engine.window_stats().context("a windowed engine")?;
             let (width, height) = (stats.width, stats.height);
             let m = compare_with_reference(&mut engine, &scene, &params, width, height)?;
-            println!(
+            out!(
                 "{} against the reference at {width}x{height}: RMSE {:.4}, penumbra RMSE {:.4}, max {:.3}",
-                params.technique.name, m.rmse, m.penumbra_rmse, m.max_abs
+                params.technique.name,
+                m.rmse,
+                m.penumbra_rmse,
+                m.max_abs
             );
         }
         for t in engine.take_timings() {
@@ -296,7 +299,7 @@ fn save_screenshot(capture: &Capture, report: &TimingReport, frames: &[FrameTimi
     let mut trace = FileTrace::create(&report.device, Path::new(&format!("{stem}-trace.json")))?;
     trace.add_frames(frames, &serde_json::json!({ "technique": report.technique }));
     trace.finish()?;
-    println!("wrote {} and its V, timings and trace", color.display());
+    out!("wrote {} and its V, timings and trace", color.display());
     Ok(())
 }
 
