@@ -111,6 +111,11 @@ vec2 outer_test(vec2 uv, float depth) {
     return vec2(bilinear(t.f, mix(vec4(1.0), t.outer, t.behind)), bilinear(t.f, mix(vec4(1.0), t.outer, t.apart)));
 }
 
+// The penumbra parameter of an outer half, ½ + ½α', where `covers` (else 1: lit).
+vec4 outer_half(vec4 alpha, vec4 covers) {
+    return 0.5 + 0.5 * mix(vec4(1.0), alpha, covers);
+}
+
 // V from each texel's lit-side factors (`lit_even`, `lit_odd`) and inner halves (`inner`), the
 // inner half in its caster's channel, the two channels' visibilities multiplied (centred_test).
 float channels(Texels t, vec4 lit_even, vec4 lit_odd, vec4 inner, vec4 deep) {
@@ -160,12 +165,14 @@ vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     float slack = 2.0 * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / map_size;
     vec4 in_front = t.behind * vec4(lessThan(t.b, depth_code(light, caster * (1.0 - slack))));
     vec4 in_back = t.behind * vec4(greaterThan(t.b, depth_code(light, caster * (1.0 + slack))));
-    vec4 lit_even = 0.5 + 0.5 * mix(vec4(1.0), t.outer, mix(t.behind, in_front + in_back * t.inner_odd, shadowed));
-    vec4 lit_odd = 0.5 + 0.5 * mix(vec4(1.0), t.outer_odd, mix(t.behind, in_front + in_back * (1.0 - t.inner_odd), shadowed));
+    vec4 other_even = in_front + in_back * t.inner_odd;
+    vec4 other_odd = in_front + in_back * (1.0 - t.inner_odd);
+    vec4 lit_even = outer_half(t.outer, mix(t.behind, other_even, shadowed));
+    vec4 lit_odd = outer_half(t.outer_odd, mix(t.behind, other_odd, shadowed));
     vec4 inner = mix(vec4(1.0), 0.5 - 0.5 * a, shadowed);
     vec4 deep = shadowed * vec4(greaterThanEqual(a, vec4(1.0)));
-    vec4 apart_even = 0.5 + 0.5 * mix(vec4(1.0), t.outer, mix(t.apart, in_front + in_back * t.inner_odd, shadowed));
-    vec4 apart_odd = 0.5 + 0.5 * mix(vec4(1.0), t.outer_odd, mix(t.apart, in_front + in_back * (1.0 - t.inner_odd), shadowed));
+    vec4 apart_even = outer_half(t.outer, mix(t.apart, other_even, shadowed));
+    vec4 apart_odd = outer_half(t.outer_odd, mix(t.apart, other_odd, shadowed));
     // An inner quad at the receiver's own depth (within the limits' slack) is its own silhouette:
     // the terminator, which with_own_plane leaves to the tangent plane.
     vec4 own = shadowed * vec4(greaterThanEqual(t.inner_b, vec4(t.code - LIMIT_SLACK)));
