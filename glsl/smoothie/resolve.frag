@@ -215,7 +215,9 @@ float penumbra_curve(float v) {
 // plane's V under another caster's penumbra: default's wingnut at 0.66 under its own wing,
 // where the truth falls to 0.3 (leaks there: 307 px of 512², 211 with the product).
 float with_own_plane(float self_lit, float v, float others) {
-    return others * min(self_lit, v / max(others, 1e-6));
+    // A surface that sees the whole light above its plane (any receiver that casts nothing)
+    // keeps the test's V exactly, whatever the two tests' umbra texels did to `others`.
+    return self_lit >= 1.0 ? v : others * min(self_lit, v / max(others, 1e-6));
 }
 
 void main() {
