@@ -231,15 +231,17 @@ fn same_caster_surface(v: &Capture, truth: &Capture, i: usize) -> bool {
 }
 
 /// A caster's own terminator: its pixels where the reference is in penumbra (V in 0.02..0.98),
-/// and the RMSE of `v` against the reference over them.
-pub fn terminator_error(v: &Capture, truth: &Capture) -> (usize, f64) {
+/// the RMSE of `v` against the reference over them, and how much darker than the reference `v`
+/// is at most there.
+pub fn terminator_error(v: &Capture, truth: &Capture) -> (usize, f64, f64) {
     assert_eq!((v.width, v.height), (truth.width, truth.height), "same size");
     let errors: Vec<f64> = (0..v.visibility.len())
         .filter(|&i| same_caster_surface(v, truth, i) && (1311..64224).contains(&truth.visibility[i]))
         .map(|i| (v.visibility[i] as f64 - truth.visibility[i] as f64) / 65535.0)
         .collect();
     let rmse = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len().max(1) as f64).sqrt();
-    (errors.len(), rmse)
+    let darker = errors.iter().fold(0.0, |d: f64, e| d.max(-e));
+    (errors.len(), rmse, darker)
 }
 
 /// The scale among `scales` (values of `knob`, ascending, with `fixed` knobs set too) at which
