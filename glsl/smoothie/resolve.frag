@@ -135,10 +135,11 @@ float channels(Texels t, vec4 lit_even, vec4 lit_odd, vec4 inner, vec4 deep) {
 
 // Centred V: the penumbra parameter, 0 umbra .. ½ hard edge .. 1 lit, through the falloff;
 // `umbra`, the hard test, where no smoothie is near (exactly the hard shadow for a point light).
-// Second, V from other blockers alone, the receiver's own silhouette left out (with_own_plane).
+// Second, V from other blockers alone, the receiver's own silhouette left out (with_own_plane),
+// computed only for a surface whose own plane hides some of the light (`self_lit` < 1).
 // `map`: the shadow map's texels around the lookup, which are the smoothie texels' own where
 // the two grids agree (SAME_GRID).
-vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
+vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map, float self_lit) {
     Texels t = texels(uv, depth);
     if (t.behind == vec4(0.0) && t.inner == vec4(1.0)) {
         return vec2(umbra, 1.0);
@@ -171,13 +172,16 @@ vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map) {
     vec4 lit_odd = outer_half(t.outer_odd, mix(t.behind, other_odd, shadowed));
     vec4 inner = mix(vec4(1.0), 0.5 - 0.5 * a, shadowed);
     vec4 deep = shadowed * vec4(greaterThanEqual(a, vec4(1.0)));
+    float v = channels(t, lit_even, lit_odd, inner, deep);
+    if (self_lit >= 1.0) {
+        return vec2(v, 1.0); // with_own_plane keeps v: most receivers, the whole ground
+    }
     vec4 apart_even = outer_half(t.outer, mix(t.apart, other_even, shadowed));
     vec4 apart_odd = outer_half(t.outer_odd, mix(t.apart, other_odd, shadowed));
     // An inner quad at the receiver's own depth (within the limits' slack) is its own silhouette:
     // the terminator, which with_own_plane leaves to the tangent plane.
     vec4 own = shadowed * vec4(greaterThanEqual(t.inner_b, vec4(t.code - LIMIT_SLACK)));
-    return vec2(channels(t, lit_even, lit_odd, inner, deep),
-                channels(t, apart_even, apart_odd, mix(inner, vec4(1.0), own), deep * (1.0 - own)));
+    return vec2(v, channels(t, apart_even, apart_odd, mix(inner, vec4(1.0), own), deep * (1.0 - own)));
 }
 
 // Whether V at this lookup can differ from the hard test's: an alpha below 1 among the four
@@ -251,7 +255,7 @@ void main() {
     // Every curve maps 0 to 0 and 1 to 1: only the penumbra needs the smoothie buffer and the
     // curve.
     if (CENTRED) {
-        vec2 v = centred_test(l.uv, l.depth, umbra, map);
+        vec2 v = centred_test(l.uv, l.depth, umbra, map, self_lit);
         out_visibility = with_own_plane(self_lit, v.x, v.y);
         return;
     }
