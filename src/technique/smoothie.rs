@@ -48,8 +48,9 @@
 //! edge-on hands the silhouette to its other edge for part of the light, whose smoothie reaches
 //! further out (`low_light`: 137 leaking pixels, 27 with them). Their smoothie edges
 //! (`geometry::smoothie::partial_smoothies`, and the compute path's) lie over their caster's
-//! outline in the map; the smoothie pass keeps them where the map is lit, and the resolve lets
-//! them darken only receivers behind the turned face.
+//! outline in the map; the smoothie pass keeps them where the map's surface lies behind the
+//! turned face (lit, or another receiver, which a partial silhouette shadows as it does the
+//! ground), and the resolve lets them darken only receivers behind the turned face.
 //!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard
