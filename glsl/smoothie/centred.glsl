@@ -62,13 +62,13 @@ bool centred_fragment(out Centred c) {
     // turned face, another caster's or a farther part of its own, whose light the partial
     // silhouette hides too. Kept only where the map was lit, it missed them: default's
     // wingnut, whose wing's silhouettes slide across its grazed top for parts of the light and
-    // shadow its body, leaked 211 px (202 kept as here). Deeper by 2 % at least, as the
-    // resolve's LIMIT_SLACK: where a fine convex caster's surface runs on past the turned face,
-    // steep near its outline, two texels' slack let its next rings through, and a partial
-    // smoothie darkened the terminator its tangent plane already shades (a speckle at 0.30 for
-    // 0.50 on the sphere at 128²).
+    // shadow its body, leaked 211 px (202 kept as here). Deeper by APART (depth.glsl) at
+    // least: where a fine convex caster's surface runs on past the turned face, steep near its
+    // outline, two texels' slack let its next rings through, and a partial smoothie darkened
+    // the terminator its tangent plane already shades (a speckle at 0.30 for 0.50 on the
+    // sphere at 128²).
     bool partial = in_range.y < 0.0;
-    if (partial && caster <= max(in_range.x + slack, in_range.x * 1.02)) {
+    if (partial && caster <= max(in_range.x + slack, in_range.x * APART)) {
         return false;
     }
     float ground = ground_depth(light, uv);

@@ -10,6 +10,11 @@
 #define SOFTSHADOW_SMOOTHIE_DEPTH_GLSL
 #include "interface.glsl"
 
+// How much deeper than a caster's surface another surface must lie to count as apart from it:
+// 2 %, more than a caster's own face slants across the few texels between a probe and the
+// smoothie it decides for (the resolve's LIMIT_SLACK, centred.glsl's partial smoothies).
+const float APART = 1.02;
+
 // 0 at (and before) near, 1 at far and beyond: an empty texel's code, behind any receiver.
 float depth_code(LightView light, float depth) {
     return clamp(log2(depth / light.depths.x) / light.depths.z, 0.0, 1.0);

@@ -56,9 +56,8 @@ struct Texels {
 };
 
 // How far past an inner quad's limit a receiver still counts as the surface there, in depth
-// codes (depth.glsl): a 2 % deeper depth, more than a caster's own face slants across the
-// few texels between the limit's probe and the inner half.
-#define LIMIT_SLACK (log2(1.02) / light.depths.z)
+// codes (depth.glsl): APART deeper.
+#define LIMIT_SLACK (log2(APART) / light.depths.z)
 
 const ivec2 GATHER_ORDER[4] = ivec2[4](ivec2(0, 1), ivec2(1, 1), ivec2(1, 0), ivec2(0, 0));
 
