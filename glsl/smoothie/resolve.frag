@@ -104,10 +104,15 @@ float min4(vec4 v) {
 }
 
 // The paper's smoothie test: α' where the receiver lies behind a smoothie, else 1; second, the
-// same from other blockers' smoothies alone (with_own_plane).
-vec2 outer_test(vec2 uv, float depth) {
+// same from other blockers' smoothies alone (with_own_plane), only for a surface whose own
+// plane hides some of the light (`self_lit` < 1), as centred_test's.
+vec2 outer_test(vec2 uv, float depth, float self_lit) {
     Texels t = texels(uv, depth);
-    return vec2(bilinear(t.f, mix(vec4(1.0), t.outer, t.behind)), bilinear(t.f, mix(vec4(1.0), t.outer, t.apart)));
+    float v = bilinear(t.f, mix(vec4(1.0), t.outer, t.behind));
+    if (self_lit >= 1.0) {
+        return vec2(v, 1.0); // with_own_plane keeps v
+    }
+    return vec2(v, bilinear(t.f, mix(vec4(1.0), t.outer, t.apart)));
 }
 
 // The penumbra parameter of an outer half, ½ + ½α', where `covers` (else 1: lit).
@@ -258,7 +263,7 @@ void main() {
         out_visibility = with_own_plane(self_lit, v.x, v.y);
         return;
     }
-    vec2 outer = outer_test(l.uv, l.depth);
+    vec2 outer = outer_test(l.uv, l.depth, self_lit);
     float v = umbra > 0.0 ? min(umbra, outer.x) : 0.0;
     out_visibility = with_own_plane(self_lit, penumbra_curve(v), penumbra_curve(outer.y));
 }
