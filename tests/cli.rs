@@ -101,14 +101,11 @@ fn techniques_lists_knobs_with_defaults() {
 /// ends as a filter does, with no panic.
 #[test]
 fn a_closed_output_pipe_ends_quietly() {
-    let mut child = softshadow()
-        .arg("techniques")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
+    // The read end is closed before the child starts, so its first write meets the broken pipe
+    // whatever the scheduling (closed after spawning, the child could finish writing first).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = softshadow().arg("techniques").stdout(writer).stderr(std::process::Stdio::piped()).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && err.is_empty(), "{:?}: {err}", out.status);
 }
