@@ -221,7 +221,8 @@ float penumbra_curve(float v) {
 // the darker of the two, not their product, which counts it twice (the sphere's terminator).
 // The darker of the plane and every blocker, as before, held a face the light grazes at the
 // plane's V under another caster's penumbra: default's wingnut at 0.66 under its own wing,
-// where the truth falls to 0.3 (default leaked 307 px of 512², 211 with the product, when it was measured).
+// where the truth falls to 0.3 (when measured, default leaked 307 px of 512², 211 with the
+// product).
 float with_own_plane(float self_lit, float v, float others) {
     // A surface that sees the whole light above its plane (any receiver that casts nothing)
     // keeps the test's V exactly, whatever the two tests' umbra texels did to `others`.
