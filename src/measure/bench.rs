@@ -179,10 +179,14 @@ impl Goal {
     }
 
     /// A table cell: the ratio of a cost; a leak rule's leaking pixels, which rates of a few
-    /// in 10⁵ would hide.
+    /// in 10⁵ would hide, and in brackets the pixels each form darkens by as much: the
+    /// outer-only form keeps the whole hard shadow dark, so a hard edge a texel off costs it
+    /// darkness where the centred form, V = ½ on the edge, errs either way.
     fn cell(&self, of: &BenchRow, base: &BenchRow) -> String {
         let mark = if self.met(of, base) { "✓" } else { "✗" };
-        let leaking = |r: &BenchRow| (r.metrics.leak_rate * r.metrics.pixels as f64).round();
+        let pixels = |rate: f64, r: &BenchRow| (rate * r.metrics.pixels as f64).round();
+        let leaking = |r: &BenchRow| pixels(r.metrics.leak_rate, r);
+        let darkened = |r: &BenchRow| pixels(r.metrics.dark_rate, r);
         match self.measure {
             Measure::Cost { .. } => {
                 let ratio = format!("{:.2} {mark}", self.value(of) / self.value(base));
@@ -191,7 +195,10 @@ impl Goal {
                     None => ratio,
                 }
             }
-            Measure::Leaks => format!("{} vs {} px {mark}", leaking(of), leaking(base)),
+            Measure::Leaks => {
+                let (leaks, dark) = ([of, base].map(leaking), [of, base].map(darkened));
+                format!("{} vs {} px {mark} (darker: {} vs {})", leaks[0], leaks[1], dark[0], dark[1])
+            }
         }
     }
 
@@ -263,7 +270,8 @@ fn round_ratios(of: &BenchRow, base: &BenchRow) -> Option<(f64, f64)> {
 pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds; in \
      brackets the least and the greatest of the same ratio within one round, how far this machine's noise moved it.";
 pub const LEAK_HEADING: &str = "## Leak rule\n\nLight-leak rates (V above the reference by more than 0.1), the centred \
-     default against the papers' outer-only form; ✓ where it leaks no more.";
+     default against the papers' outer-only form; ✓ where it leaks no more. In brackets the pixels below the \
+     reference by more than 0.1, which the outer-only form's whole-umbra hard shadow trades its leaks for.";
 
 /// The scenes of `rows`, in their order (the sweep keeps each scene's rows together).
 fn scenes(rows: &[BenchRow]) -> Vec<&str> {
@@ -557,7 +565,7 @@ mod tests {
     #[test]
     fn the_leak_rule_holds_where_the_centred_form_leaks_no_more_than_the_outer_only_one() {
         let leaking = |scene: &str, setting: &str, leak_rate| BenchRow {
-            metrics: Metrics { leak_rate, pixels: 10_000, ..Default::default() },
+            metrics: Metrics { leak_rate, dark_rate: 0.5 * leak_rate, pixels: 10_000, ..Default::default() },
             ..row(scene, "plateau", setting, 1.0)
         };
         let outer = "penumbra=0 falloff=0";
@@ -574,7 +582,8 @@ mod tests {
         // Equal rates (none at all, say) meet it; a higher one does not.
         assert_eq!(plateau.outcome(&rows).unwrap(), "plateau leaks ≤ plateau penumbra=0 falloff=0: met on 2/3 scenes");
         let table = goal_table(LEAK_HEADING, vec![plateau], &rows);
-        for line in ["| a | 0 vs 0 px ✓ |", "| b | 20 vs 10 px ✗ |", "| met | 2/3 |"] {
+        for line in ["| a | 0 vs 0 px ✓ (darker: 0 vs 0) |", "| b | 20 vs 10 px ✗ (darker: 10 vs 5) |", "| met | 2/3 |"]
+        {
             assert!(table.lines().any(|l| l == line), "{line} in\n{table}");
         }
     }
