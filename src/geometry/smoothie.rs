@@ -371,12 +371,13 @@ pub fn merged_smoothies(
 /// outline in the map, where a face seen nearly edge-on from the light's centre is a sliver
 /// beside the silhouette, and for the part of the light behind that face it is the silhouette:
 /// its smoothie, nearer the light than the silhouette's, reaches further out. Marked (near,
-/// far) = (b, −1): the smoothie pass keeps them only where the map's surface lies behind b,
-/// so they only darken the outer half, and only receivers behind b, the deepest of the edge's
-/// and the turned vertex's depths: the turned face's own surface, which its soft terminator
-/// already shades (the resolve), lies in front (low_light's front face: 759 px too dark by
-/// over 0.1 without it). No corners: the silhouette's cover the outline's turns. The reach
-/// compared is the alpha's on the farthest receiver (t·k, [`reach`]); on any receiver at depth r the
+/// far) = (b, −1): the smoothie pass keeps them only where the map's surface lies behind b
+/// (by 2 % or two map texels, whichever is more: glsl/smoothie/centred.glsl), so they only
+/// darken the outer half, and only receivers behind b, the deepest of the edge's and the
+/// turned vertex's depths: the turned face's own surface, which its soft terminator already
+/// shades (the resolve), lies in front (low_light's front face: 759 px too dark by over 0.1
+/// without it). No corners: the silhouette's cover the outline's turns. The reach compared is
+/// the alpha's on the farthest receiver (t·k, [`reach`]); on any receiver at depth r the
 /// difference of two smoothies' reach is that of their t, R/b − R/r taken from both.
 pub fn partial_smoothies(
     view: &Mat4,
