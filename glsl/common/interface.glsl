@@ -53,7 +53,7 @@ struct PlateauView {
     vec4 plane_u;       // xyz; w unused
     vec4 plane_v;       // xyz
     vec4 window;        // u0, v0, u1, v1: the part of the plane the texture covers
-    uvec4 sheets;       // centred: first sheet's record, sheet count (plateau/probes.comp); -, -
+    uvec4 sheets;       // the wedge count (the sheets follow), centred: the sheet count (plateau/probes.comp); -, -
 };
 
 // One caster's silhouette dispatch (glsl/smoothie/silhouettes.comp). 256 bytes, so an array of

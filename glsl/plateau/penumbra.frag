@@ -25,9 +25,12 @@ layout(constant_id = 2) const bool SHEETS = false;
 // Centred, the outer halves of partial silhouettes (geometry::plateau::partial_sides): their
 // hard edges lie inside the hard shadow, so they write only where the mask is lit.
 layout(constant_id = 3) const bool PARTIAL = false;
+// Centred, the sides near the hard shadow's corners (corners.glsl), drawn apart from the rest.
+layout(constant_id = 4) const bool CORNERS = false;
 
 #include "mask.glsl"
 #include "probes.glsl"
+#include "corners.glsl"
 
 layout(location = 0) in vec2 in_local;
 layout(location = 1) in vec2 in_uv;
@@ -40,6 +43,14 @@ layout(location = 6) flat in uint in_caster;
 // many samples.
 layout(location = 7) flat in uvec4 in_probes;
 layout(location = 8) flat in uint in_samples;
+// Centred, the corners (penumbra.vert, corners.glsl).
+layout(location = 9) flat in vec4 in_corner0;
+layout(location = 10) flat in vec4 in_axes0;
+layout(location = 11) flat in vec4 in_corner1;
+layout(location = 12) flat in vec4 in_axes1;
+layout(location = 13) flat in vec4 in_turns;
+// The plateau parameter, signed (−1 .. 1: centred corners write below 0, corners.glsl) and
+// stored as ½ + ½·t in the unsigned texture; the resolve reads it back.
 layout(location = 0) out vec2 out_t;
 
 float cross2(vec2 a, vec2 b) {
@@ -105,30 +116,60 @@ vec2 in_channel(uint caster, float t) {
     return !OVERLAPS || caster % 2u == 1u ? vec2(t, 1.0) : vec2(1.0, t);
 }
 
-void main() {
-    // Before any discard: derivatives need every fragment of the quad.
-    vec2 texel = fwidth(in_local);
-    float t, s = 0.0;
-    if (SHEETS) {
-        if (!sheet_t(texel, t, s)) {
-            discard;
-        }
-    } else {
-        t = wedge_t(in_local, in_shape0.xy);
-        if (t > 1.0) {
-            discard; // off the base: t = 1 (lit) is what the texture holds there
-        }
+// What the sheet's nearer corner adds to V at `from_a` (plane units from a), with `own` its
+// edge's outward normal. One corner a fragment: both cost llvmpipe, which runs every branch,
+// twice the arithmetic on every fragment near either, and only an edge shorter than about two
+// footprints has fragments whose footprint reaches past both of its ends.
+float sheet_corner_gain(vec2 from_a, vec2 own) {
+    vec2 p0 = from_a - in_corner0.xy, p1 = from_a - in_corner1.xy;
+    bool first = dot(p0, p0) <= dot(p1, p1);
+    vec4 corner = first ? in_corner0 : in_corner1;
+    mat2 axes = mat2(first ? in_axes0 : in_axes1);
+    vec2 p = first ? p0 : p1;
+    vec3 mine, other;
+    if (!footprint_line(axes, own, p, mine) || !footprint_line(axes, corner.zw, p, other)) {
+        return 0.0;
     }
-    out_t = vec2(t, 1.0);
-    if (!CENTRED) {
-        return;
+    return corner_v(mine, other, (first ? in_turns.z : in_turns.w) > 0.5) - disk_below(mine.z);
+}
+
+// What the wedge's corner adds to V at y (unit-disk coordinates from the apex, t its cone's),
+// and the side of the hard edge it lies on (1 outside, −1 inside). The cone's own line is the
+// tangent of its base scaled by t at y, x·y from the apex in disk units (x = y/t − lean, its
+// rim point): where a sheet leaves the cone, the sheet's edge.
+float wedge_corner_gain(vec2 y, float t, out float side) {
+    mat2 axes = mat2(in_axes0);
+    vec3 one, other;
+    side = 1.0;
+    if (!footprint_line(axes, in_corner0.zw, axes * y, one) || !footprint_line(axes, in_corner1.zw, axes * y, other)) {
+        return 0.0;
     }
+    bool convex = in_turns.z > 0.5;
+    side = (convex ? one.z < 0.0 && other.z < 0.0 : one.z < 0.0 || other.z < 0.0) ? -1.0 : 1.0;
+    vec2 rim = t > 0.0 ? y / t - in_shape0.xy : vec2(1.0, 0.0);
+    return corner_v(one, other, convex) - disk_below(side * dot(rim, y));
+}
+
+// The t a centred side writes: its own t on `side` (1 outside the hard edge, −1 inside),
+// with `gain` added to V through the disk-edge curve (the distance that curve takes to V), its
+// sign the one the resolve takes off: −1 where the mask holds the side's own caster (`own`).
+// The mask, not the side: near a corner t is far from 0 on the hard edge, and where the mask's
+// rasterised edge and the side's line part by a texel (a sharp spike's sliver) the side's sign
+// flipped single pixels between lit and umbra. Where nothing is added, t itself.
+float with_corner(float t, float side, float gain, bool own) {
+    return gain == 0.0 ? t : (own ? -1.0 : 1.0) * disk_below_inverse(disk_below(side * t) + gain);
+}
+
+// Centred: whether this side writes here (its foot on the hard shadow's boundary, or an
+// outer band over another caster's hard shadow) and what, per channel.
+bool centred_t(float t, float s, out vec2 written) {
+    written = vec2(1.0);
     if (PARTIAL) {
         if (caster_at(gl_FragCoord.xy) != 0u) {
-            discard;
+            return false;
         }
-        out_t = in_channel(in_caster, t);
-        return;
+        written = in_channel(in_caster, t);
+        return true;
     }
     uint here = OVERLAPS ? caster_at(gl_FragCoord.xy) : 0u;
     // Whether the foot lies on the hard shadow's boundary (one side lit), whether its own
@@ -148,7 +189,7 @@ void main() {
         vec2 foot = in_shape1.zw * size;
         vec2 from_foot = in_uv * size - foot;
         if (dot(from_foot, from_foot) < 1e-8) {
-            discard; // on the apex itself: the sheets meeting there write it
+            return false; // on the apex itself: the sheets meeting there write it
         }
         vec2 probe = PROBE * normalize(from_foot);
         uint a = caster_at(foot + probe), b = caster_at(foot - probe);
@@ -156,17 +197,44 @@ void main() {
         own_both = a == in_caster && b == in_caster;
         outer_half = false;
     }
-    if (here == 0u || here == in_caster) {
-        if (!boundary) {
+    // On its own caster's side of the mask, or none: where the foot is on the boundary. Over
+    // another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
+    // something other than its own caster across it, in the other channel.
+    bool mine = here == 0u || here == in_caster;
+    if (mine ? !boundary : !outer_half || own_both) {
+        return false; // before the corners' arithmetic, which nothing written needs
+    }
+    float signed_t = t;
+    if (CORNERS) {
+        float side = outer_half ? 1.0 : -1.0;
+        float gain = SHEETS ? sheet_corner_gain(in_local, in_turns.xy) : wedge_corner_gain(in_local, t, side);
+        // One caster's mask is read only near corners.
+        uint under = OVERLAPS ? here : caster_at(gl_FragCoord.xy);
+        signed_t = with_corner(t, side, gain, under == in_caster);
+    }
+    written = in_channel(mine ? in_caster : here + 1u, signed_t);
+    return true;
+}
+
+void main() {
+    // Before any discard: derivatives need every fragment of the quad.
+    vec2 texel = fwidth(in_local);
+    float t, s = 0.0;
+    if (SHEETS) {
+        if (!sheet_t(texel, t, s)) {
             discard;
         }
-        out_t = in_channel(in_caster, t);
-        return;
+    } else {
+        t = wedge_t(in_local, in_shape0.xy);
+        if (t > 1.0) {
+            discard; // off the base: t = 1 (lit) is what the texture holds there
+        }
     }
-    // Over another caster's hard shadow: an outer band (a sheet's outer half) of an edge with
-    // something other than its own caster across it.
-    if (!outer_half || own_both) {
-        discard;
+    vec2 written = vec2(t, 1.0);
+    if (CENTRED) {
+        if (!centred_t(t, s, written)) {
+            discard;
+        }
     }
-    out_t = in_channel(here + 1u, t);
+    out_t = 0.5 + 0.5 * written;
 }

@@ -12,6 +12,7 @@
 // probes.comp found along its hard edge: the fragments read that, and a sheet with its foot
 // nowhere on the boundary (an interior fold's) is not drawn.
 #include "interface.glsl"
+#include "mask.glsl"
 #include "probes.glsl"
 
 // As penumbra.frag's.
@@ -19,10 +20,14 @@ layout(constant_id = 0) const bool CENTRED = false;
 // Sheets (6 vertices a primitive) or wedges (9).
 layout(constant_id = 2) const bool SHEETS = false;
 layout(constant_id = 3) const bool PARTIAL = false;
+// As penumbra.frag's: the sides near corners.
+layout(constant_id = 4) const bool CORNERS = false;
 
 layout(set = 0, binding = 0) uniform Plateau { PlateauView plateau; };
-// Wedges: apex, lean | axes (columns) | from, to, caster, -. Sheets: a, b | ta, tb | normal,
-// caster, hull (bits). Wedges first, then sheets: gl_VertexIndex counts from the first.
+// Wedges (WEDGE_VEC4S): apex, lean | axes (columns) | from, to, caster, convex | the normals
+// of the apex's two edges. Sheets (SHEET_VEC4S): a, b | ta, tb | normal, caster, hull (bits) |
+// then per corner (at a, at b): its vertex, the other edge's normal | the vertex cone's axes.
+// Wedges first, then sheets: gl_VertexIndex counts from the first.
 layout(std430, set = 0, binding = 2) readonly buffer Sides { vec4 sides[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Probes { SheetProbes probes[]; };
 
@@ -41,12 +46,44 @@ layout(location = 6) flat out uint out_caster;
 // Centred sheets: their mask probes along the hard edge (probes.comp), for the fragments.
 layout(location = 7) flat out uvec4 out_probes;
 layout(location = 8) flat out uint out_samples;
+// Centred, the corners (corners.glsl): per corner, its vertex from the primitive's origin (a
+// sheet's a, a wedge's apex) and the other edge's normal | the footprint's axes; the sheet's
+// own normal, 1 where convex at each corner (wedges: their one corner, both normals).
+layout(location = 9) flat out vec4 out_corner0;
+layout(location = 10) flat out vec4 out_axes0;
+layout(location = 11) flat out vec4 out_corner1;
+layout(location = 12) flat out vec4 out_axes1;
+layout(location = 13) flat out vec4 out_turns;
+
+// Whether the hard shadow about a corner at `at` (plane units) is what its two lines (outward
+// normals `one`, `other`) say: the mask PROBE texels out along the four bisectors of the lines,
+// shadow in only the one inside both (convex) or in all but the one outside both (reflex). Not
+// where the other edge is an interior fold (the cow's legs against its body) or lies off the
+// boundary, or where a spike is too thin for the mask to show: no corner there. Unchecked,
+// corners at the cow's legs drew its umbra lit (default's penumbra RMSE 0.169, 0.141 checked,
+// 512², edges a footprint radius long).
+bool corner_holds(vec2 at, vec2 one, vec2 other, bool convex) {
+    vec2 size = vec2(textureSize(mask, 0));
+    vec2 to_texels = size / (plateau.window.zw - plateau.window.xy);
+    vec2 centre = (at - plateau.window.xy) * to_texels;
+    vec2 bisectors[4] = vec2[4](-one - other, one + other, other - one, one - other);
+    bool holds = true;
+    for (int k = 0; k < 4; k++) {
+        vec2 d = bisectors[k] * to_texels;
+        bool shadow = caster_at(centre + PROBE * d / max(length(d), 1e-30)) != 0u;
+        // k = 0 inside both, 1 outside both, 2 and 3 inside one.
+        holds = holds && shadow == (k == 0 || !convex && k != 1);
+    }
+    return holds;
+}
 
 void main() {
     uint per = SHEETS ? 6u : 9u;
-    uint record = 3u * (uint(gl_VertexIndex) / per);
+    uint primitive = uint(gl_VertexIndex) / per;
+    uint record = SHEETS ? WEDGE_VEC4S * plateau.sheets.x + SHEET_VEC4S * (primitive - plateau.sheets.x)
+                         : WEDGE_VEC4S * primitive;
     uint corner = uint(gl_VertexIndex) % per;
-    vec4 r0 = sides[record], r1 = sides[record + 1u], r2 = sides[record + 2u];
+    vec4 r0 = sides[record], r1 = sides[record + 1u], r2 = sides[record + 2u], r3 = sides[record + 3u];
     vec2 extent = plateau.window.zw - plateau.window.xy;
     vec2 p;
     out_probes = uvec4(0u);
@@ -61,6 +98,18 @@ void main() {
         out_edge = (r0.zw - a) / extent;
         out_normal = r2.xy / extent;
         out_caster = uint(r2.z);
+        vec4 r4 = sides[record + 4u], r5 = sides[record + 5u], r6 = sides[record + 6u];
+        uint convex = floatBitsToUint(r2.w) >> 12u;
+        out_corner0 = vec4(r3.xy - a, r3.zw);
+        out_axes0 = r4;
+        out_corner1 = vec4(r5.xy - a, r5.zw);
+        out_axes1 = r6;
+        out_turns = vec4(r2.xy, float(convex & 1u), float(convex >> 1u & 1u));
+        if (CORNERS) {
+            // Zero normals: no corner (corners.glsl's footprint_line).
+            out_corner0.zw *= float(corner_holds(r3.xy, r2.xy, r3.zw, out_turns.z > 0.5));
+            out_corner1.zw *= float(corner_holds(r5.xy, r2.xy, r5.zw, out_turns.w > 0.5));
+        }
         if (CENTRED && !PARTIAL) {
             SheetProbes probed = probes[uint(gl_VertexIndex) / per - plateau.sheets.x];
             out_probes = probed.bits;
@@ -85,6 +134,14 @@ void main() {
         out_edge = vec2(0.0);
         out_normal = vec2(0.0);
         out_caster = uint(r2.z);
+        out_corner0 = vec4(0.0, 0.0, r3.xy);
+        out_axes0 = r1;
+        out_corner1 = vec4(0.0, 0.0, r3.zw);
+        out_axes1 = r1;
+        out_turns = vec4(0.0, 0.0, r2.w, r2.w);
+        if (CORNERS && !corner_holds(apex, r3.xy, r3.zw, r2.w > 0.5)) {
+            out_corner0.zw = vec2(0.0);
+        }
     }
     vec2 uv = (p - plateau.window.xy) / extent;
     out_uv = uv;

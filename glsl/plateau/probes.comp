@@ -29,7 +29,7 @@ void main() {
     if (i >= plateau.sheets.y) {
         return;
     }
-    uint record = 3u * (plateau.sheets.x + i);
+    uint record = WEDGE_VEC4S * plateau.sheets.x + SHEET_VEC4S * i;
     vec4 r0 = sides[record], r2 = sides[record + 2u];
     // In texels, as penumbra.frag finds the foot: a + s·(b − a).
     vec2 to_texels = vec2(textureSize(mask, 0)) / (plateau.window.zw - plateau.window.xy);

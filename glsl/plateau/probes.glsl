@@ -3,6 +3,10 @@
 #ifndef SOFTSHADOW_PLATEAU_PROBES_GLSL
 #define SOFTSHADOW_PLATEAU_PROBES_GLSL
 
+// The sides' records (geometry::plateau::Wedge, Sheet), in vec4s.
+const uint WEDGE_VEC4S = 4u;
+const uint SHEET_VEC4S = 7u;
+
 // Most samples a sheet's probes hold (a bit each in each half of `bits`): the CPU cuts longer
 // sheets into pieces, for a sample every texel.
 const uint SAMPLES = 64u;

@@ -59,8 +59,9 @@ vec2 plateau_s(vec2 tc) {
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     vec2 f = fract(pos);
     vec2 corner = (floor(pos) + 1.0) / size;
-    vec4 r = textureGather(plateau_texture, corner, 0);
-    vec4 g = CENTRED && CHANNELS ? textureGather(plateau_texture, corner, 1) : vec4(1.0);
+    // Stored as ½ + ½·t (penumbra.frag).
+    vec4 r = 2.0 * textureGather(plateau_texture, corner, 0) - 1.0;
+    vec4 g = CENTRED && CHANNELS ? 2.0 * textureGather(plateau_texture, corner, 1) - 1.0 : vec4(1.0);
     uvec4 casters = uvec4(round(textureGather(umbra_mask, corner, 0) * 65535.0));
     vec2 s[4];
     for (int k = 0; k < 4; k++) {

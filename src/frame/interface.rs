@@ -67,8 +67,9 @@ pub struct PlateauView {
     pub plane_u: Vec4,
     pub plane_v: Vec4,
     pub window: Vec4,
-    /// Centred: the first sheet's record in the sides buffer and the number of sheets, whose
-    /// mask probes `glsl/plateau/probes.comp` finds; then 0, 0.
+    /// The number of wedges, whose records precede the sheets' in the sides buffer, and,
+    /// centred, the number of sheets, whose mask probes `glsl/plateau/probes.comp` finds; then
+    /// 0, 0.
     pub sheets: UVec4,
 }
 

@@ -284,9 +284,33 @@ pub struct Sheet {
     pub normal: [f32; 2],
     pub caster: f32,
     /// The hull as two triangles: six corner numbers of 2 bits, the first lowest (0 a, 1 b,
-    /// 2 tb, 3 ta; a triangular hull repeats a corner).
+    /// 2 tb, 3 ta; a triangular hull repeats a corner); above them [`CONVEX_BITS`].
     pub hull: u32,
+    /// Where the whole edge's ends (a piece's too) meet the next edges of the outline.
+    pub corners: [Corner; 2],
 }
+
+/// A vertex of the hard shadow's outline where two silhouette edges meet (issue 20): the
+/// penumbra there is the light's footprint cut by both edges' lines, where the sheets alone
+/// take one line each. `neighbour` is zero where the vertex has no such pair (an open chain's
+/// end, three or more edges): no corner then.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Corner {
+    /// The vertex's hard shadow.
+    pub at: [f32; 2],
+    /// The other edge's outward unit normal.
+    pub neighbour: [f32; 2],
+    /// The vertex cone's semi-axes (columns): the light's footprint there, as an ellipse.
+    pub axes: [f32; 4],
+}
+
+/// Bits 12 and 13 of [`Sheet::hull`]: whether the hard shadow is convex at corner 0 (at a),
+/// corner 1 (at b), where it is the intersection of the two edges' inner sides, not their union.
+pub const CONVEX_BITS: u32 = 3 << 12;
+
+// The records' sizes as glsl/plateau/probes.glsl reads them (WEDGE_VEC4S, SHEET_VEC4S).
+const _: () = assert!(size_of::<Sheet>() == 7 * 16 && size_of::<Wedge>() == 4 * 16);
 
 /// Slack of the inverse map's s and t at the patch's sides (f32 rounding): a fragment on a side
 /// shared with a neighbour is drawn by both rather than by neither.
@@ -299,7 +323,30 @@ const FOLD_SLACK: f32 = 1e-4;
 impl Sheet {
     fn new(a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> Self {
         let hull = hull_triangles([a, b, tb, ta]).iter().enumerate().fold(0, |bits, (k, &c)| bits | (c << (2 * k)));
-        Sheet { a: a.into(), b: b.into(), ta: ta.into(), tb: tb.into(), normal: normal.into(), caster, hull }
+        let corners = [Corner::default(); 2];
+        Sheet { a: a.into(), b: b.into(), ta: ta.into(), tb: tb.into(), normal: normal.into(), caster, hull, corners }
+    }
+
+    /// Whether a corner can change V anywhere on this sheet (a piece, see [`Sheet::pieces`]):
+    /// where the light's footprint about a point reaches past the corner, within a footprint
+    /// radius (the cone's semi-major axis) of it, and the point within the sheet's width of its
+    /// foot: a foot within radius + width of the corner, over sin 60° for a turn of 120°.
+    pub fn near_corner(&self) -> bool {
+        let (a, b) = (Vec2::from(self.a), Vec2::from(self.b));
+        let width = (Vec2::from(self.ta) - a).length().max((Vec2::from(self.tb) - b).length());
+        self.corners.iter().filter(|c| c.neighbour != [0.0; 2]).any(|c| {
+            let axes = Mat2::from_cols_array(&c.axes);
+            let radius = axes.col(0).length().max(axes.col(1).length());
+            let at = Vec2::from(c.at);
+            let along = (at - a).dot(b - a) / (b - a).length_squared().max(f32::MIN_POSITIVE);
+            at.distance(a.lerp(b, along.clamp(0.0, 1.0))) <= 1.25 * (radius + width)
+        })
+    }
+
+    /// The sheet with its edge's corners (at a, at b) and whether the shadow is convex there.
+    fn with_corners(self, corners: [Corner; 2], convex: [bool; 2]) -> Self {
+        let bits = (u32::from(convex[0]) | u32::from(convex[1]) << 1) << 12;
+        Sheet { hull: self.hull & !CONVEX_BITS | bits, corners, ..self }
     }
 
     /// The corners, in the order the hull numbers them: a, b, tb, ta.
@@ -329,7 +376,8 @@ impl Sheet {
         (0..n).map(move |k| {
             let [s0, s1] = [k, k + 1].map(|k| k as f32 / n as f32);
             let [a, b, ta, tb] = [(s0, 0.0), (s1, 0.0), (s0, 1.0), (s1, 1.0)].map(|(s, t)| self.point(s, t));
-            Sheet::new(a, b, ta, tb, self.normal.into(), self.caster)
+            let piece = Sheet::new(a, b, ta, tb, self.normal.into(), self.caster);
+            Sheet { hull: piece.hull | self.hull & CONVEX_BITS, corners: self.corners, ..piece }
         })
     }
 
@@ -418,7 +466,10 @@ pub struct Wedge {
     pub from: f32,
     pub to: f32,
     pub caster: f32,
-    pad: f32,
+    /// 1 where the hard shadow is convex at the apex (see [`CONVEX_BITS`]), else 0.
+    pub convex: f32,
+    /// The outward unit normals of the apex's two edges, zero where it is no [`Corner`].
+    pub normals: [f32; 4],
 }
 
 /// The widest rim arc of one [`Wedge`]: a quarter turn keeps its trapezoid within √2 of the rim.
@@ -438,6 +489,11 @@ impl Wedge {
         let unit = [-lean, u0, u1, u0, far0, far1, u0, far1, u1];
         let (apex, axes) = (Vec2::from(self.apex), self.axes());
         unit.map(|x| apex + axes * (x + lean))
+    }
+
+    /// Whether the apex is a [`Corner`].
+    pub fn at_corner(&self) -> bool {
+        self.normals != [0.0; 4]
     }
 
     /// The cone's t at `p` (beyond 1 off the base): with y = axes⁻¹·(p − apex), the positive
@@ -495,7 +551,7 @@ impl PlateauGeometry {
 
     /// The part of a cone over the rim angles `from`..`to` (radians, `from` < `to` ≤ `from` +
     /// 2π), as pieces of at most [`WEDGE_SPAN`]. A cone without area (a flat base) draws nothing.
-    fn push_wedge(&mut self, cone: &Cone, (from, to): (f32, f32), caster: f32) {
+    fn push_wedge(&mut self, cone: &Cone, (from, to): (f32, f32), caster: f32, corner: Option<WedgeCorner>) {
         if cone.axes.determinant() <= 0.0 {
             return;
         }
@@ -516,7 +572,8 @@ impl PlateauGeometry {
                 from: a,
                 to: b,
                 caster,
-                pad: 0.0,
+                convex: corner.map_or(0.0, |c| f32::from(u8::from(c.convex))),
+                normals: corner.map_or([0.0; 4], |c| [c.normals.0.x, c.normals.0.y, c.normals.1.x, c.normals.1.y]),
             };
             self.cones.push(wedge);
         }
@@ -630,6 +687,34 @@ pub fn plateau_sides(
     }
     let cone_of_end = &cone_of_end;
     let cone = |end: usize| cones[cone_of_end[end] as usize];
+    // Each edge's outward normal, where both its ends cast; then, where a vertex joins two
+    // edges, each end's corner (the other edge's normal) and the turn there.
+    let normals: Vec<Option<Vec2>> = edges
+        .par_iter()
+        .enumerate()
+        .map(|(i, &(_, inner))| {
+            let (ca, cb) = (cone(2 * i)?, cone(2 * i + 1)?);
+            Some(outward(&ca, &cb, plane.project(light.position, world(inner))?))
+        })
+        .collect();
+    let mut other_end = vec![None; ends.len()];
+    for g in groups.iter().filter(|g| g.len() == 2 && g[0].1 / 2 != g[1].1 / 2) {
+        let (e0, e1) = (g[0].1 as usize, g[1].1 as usize);
+        (other_end[e0], other_end[e1]) = (Some(e1), Some(e0));
+    }
+    let corner = |end: usize| -> Option<(Corner, bool)> {
+        let (mine, theirs) = (normals[end / 2]?, normals[other_end[end]? / 2]?);
+        let (at, far) = (cone(end)?, cone(end ^ 1)?);
+        let beyond = cone(other_end[end]? ^ 1)?.centre;
+        // Both lines stand for their edges only as far as the edges run: the footprint about
+        // the corner may not reach past either's other end.
+        let reach = CORNER_REACH * at.axes.col(0).length().max(at.axes.col(1).length());
+        let long = (far.centre - at.centre).length() >= reach && (beyond - at.centre).length() >= reach;
+        (long && mine.perp_dot(theirs).abs() > MIN_TURN).then(|| {
+            let corner = Corner { at: at.centre.into(), neighbour: theirs.into(), axes: at.axes.to_cols_array() };
+            (corner, theirs.dot(far.centre - at.centre) < 0.0)
+        })
+    };
     // Chunks of edges, then of vertices, in parallel (rayon), put together in order.
     let parts: Vec<(PlateauGeometry, Vec<Covers>)> = edges
         .par_chunks(PARALLEL_CHUNK)
@@ -637,11 +722,14 @@ pub fn plateau_sides(
         .map(|(c, chunk)| {
             let mut out = PlateauGeometry::default();
             let mut covers = Vec::with_capacity(2 * chunk.len());
-            for (j, &(_, inner)) in chunk.iter().enumerate() {
+            for j in 0..chunk.len() {
                 let i = c * PARALLEL_CHUNK + j;
-                let ends = (cone(2 * i), cone(2 * i + 1));
-                let inside = plane.project(light.position, world(inner));
-                covers.extend(edge_sheets(&mut out, light.penumbra, ends, inside, number));
+                let (Some(ca), Some(cb), Some(normal)) = (cone(2 * i), cone(2 * i + 1), normals[i]) else {
+                    covers.extend([[None; 2]; 2]);
+                    continue;
+                };
+                let corners = [corner(2 * i), corner(2 * i + 1)];
+                covers.extend(edge_sheets(&mut out, light.penumbra, (ca, cb), normal, corners, number));
             }
             (out, covers)
         })
@@ -659,10 +747,15 @@ pub fn plateau_sides(
             let mut out = PlateauGeometry::default();
             let (mut arcs, mut gaps) = (Vec::new(), Vec::new());
             for group in chunk {
-                let Some(cone) = cone(group[0].1 as usize) else { continue };
+                let end = group[0].1 as usize;
+                let Some(cone) = cone(end) else { continue };
                 out.grow(cone.centre);
                 let covered = group.iter().flat_map(|(_, end)| covers[*end as usize]).flatten();
-                vertex_wedges(&mut out, &cone, light, covered, (&mut arcs, &mut gaps), number);
+                // The corner seen from its first edge: both normals, and the turn.
+                let corner = corner(end).and_then(|(c, convex)| {
+                    Some(WedgeCorner { normals: (normals[end / 2]?, c.neighbour.into()), convex })
+                });
+                vertex_wedges(&mut out, &cone, light, covered, (&mut arcs, &mut gaps), (number, corner));
             }
             out
         })
@@ -690,24 +783,46 @@ const PARALLEL_CHUNK: usize = 256;
 /// hard shadow there is t = 0 whatever the sides hold).
 type Covers = [Option<(Vec2, Vec2)>; 2];
 
-/// The sheets of an edge between the cones of its ends, `inside` the projected third vertex of
-/// its light-facing triangle, into `out`; what they cover at each end.
+/// How far (the sine of the angle) two edges must turn at a vertex for it to be a [`Corner`].
+/// A finely tessellated curve turns less at each vertex, where the footprint cut by both lines
+/// differs from the sheets' by well under 1/255.
+const MIN_TURN: f32 = 0.02;
+
+/// How many footprint radii (the cone's semi-major axis) each of a [`Corner`]'s edges must run
+/// from it: a line that runs on past its edge's end, a radius or more, cuts the footprint where
+/// the next edge does (a simplified mesh's short edges). Measured on default (the cow's shadow,
+/// 512²): leaks past the reference by 0.1, 1056 px with no bound, 1041 at ½, 1046 at 1, 1044 at 2
+/// (as without corners), where the sphere's corners were lost too (penumbra RMSE 0.0137 → 0.0163).
+const CORNER_REACH: f32 = 0.5;
+
+/// A corner as its wedges carry it: the outward normals of its two edges, and whether the
+/// shadow is convex there.
+#[derive(Clone, Copy, Debug)]
+struct WedgeCorner {
+    normals: (Vec2, Vec2),
+    convex: bool,
+}
+
+/// The sheets of an edge between the cones of its ends, `normal` its outward normal, with the
+/// corners at its ends (and whether the shadow is convex there), into `out`; what they cover at
+/// each end.
 fn edge_sheets(
     out: &mut PlateauGeometry,
     penumbra: Penumbra,
-    ends: (Option<Cone>, Option<Cone>),
-    inside: Option<Vec2>,
+    (ca, cb): (Cone, Cone),
+    normal: Vec2,
+    corners: [Option<(Corner, bool)>; 2],
     number: f32,
 ) -> [Covers; 2] {
     let mut covers = [[None; 2]; 2];
-    let ((Some(ca), Some(cb)), Some(inside)) = (ends, inside) else { return covers };
-    let normal = outward(&ca, &cb, inside);
+    let convex = corners.map(|c| c.is_some_and(|c| c.1));
+    let corners = corners.map(|c| c.map_or(Corner::default(), |c| c.0));
     let ab = cb.centre - ca.centre;
     for (k, side) in [normal, -normal].into_iter().enumerate() {
         let cover = if k == 0 || penumbra == Penumbra::Centred {
             let Some((ta, tb)) = outer_tangent(&ca, &cb, side) else { continue };
             let Some(sheet) = out.sheet(ca.centre, cb.centre, ta, tb, normal, number) else { continue };
-            out.sheets.push(sheet);
+            out.sheets.push(sheet.with_corners(corners, convex));
             (ta - ca.centre, tb - cb.centre)
         } else {
             (side, side)
@@ -796,7 +911,7 @@ fn vertex_wedges(
     light: &PlateauLight,
     covered: impl Iterator<Item = (Vec2, Vec2)>,
     (arcs, gaps): (&mut Arcs, &mut Arcs),
-    number: f32,
+    (number, corner): (f32, Option<WedgeCorner>),
 ) {
     // A point or a flat base has no area to draw (and no rim angles).
     if cone.axes.determinant() <= 0.0 {
@@ -819,7 +934,7 @@ fn vertex_wedges(
     let overlap = if arcs.is_empty() { 0.0 } else { WEDGE_OVERLAP };
     uncovered(arcs, gaps);
     for &(from, to) in gaps.iter() {
-        out.push_wedge(cone, (from - overlap, to + overlap), number);
+        out.push_wedge(cone, (from - overlap, to + overlap), number, corner);
     }
 }
 
@@ -994,7 +1109,7 @@ mod tests {
             let cone = vertex_cone(&plane, Vec3::from(light), 0.5, PenumbraSize::Physical { scale: 1.0 }, Vec3::new(0.3, 1.0, -0.2));
             let cone = cone.unwrap();
             let mut g = PlateauGeometry::default();
-            g.push_wedge(&cone, (from, from + span), 1.0);
+            g.push_wedge(&cone, (from, from + span), 1.0, None);
             prop_assert_eq!(g.cones.len(), 1);
             let wedge = g.cones[0];
             let rim = rim(&cone, from + f * span);
@@ -1168,7 +1283,7 @@ mod tests {
                 let mut pieces = PlateauGeometry::default();
                 let cones = whole_cones.map(|c| {
                     pieces.cones.clear();
-                    pieces.push_wedge(&c, (0.0, TAU), 1.0);
+                    pieces.push_wedge(&c, (0.0, TAU), 1.0, None);
                     (plateau_field(&pieces, bounds, cells), tessellated_field(&tessellate_cone(&c, 720), bounds, cells))
                 });
                 for (what, pairs) in [("sheets", sheets.collect::<Vec<_>>()), ("cones", cones.collect())] {
@@ -1334,9 +1449,21 @@ mod tests {
                 let middle = apex + Mat2::from_cols_array(&w.axes) * Vec2::from_angle(0.5 * (w.from + w.to));
                 assert!(middle.abs().min_element() > half - 1e-3, "{penumbra:?}: a wedge outside the shadow");
                 turned += w.to - w.from;
+                // Each apex a convex corner of two perpendicular edges.
+                let n = Vec2::from_slice(&w.normals[..2]).dot(Vec2::from_slice(&w.normals[2..]));
+                assert!(w.at_corner() && w.convex == 1.0 && n.abs() < 1e-3, "{penumbra:?}: {w:?}");
             }
             let expected = 4.0 * (std::f32::consts::FRAC_PI_2 + 2.0 * WEDGE_OVERLAP);
             assert!((turned - expected).abs() < 1e-3, "{penumbra:?}: the wedges turn {turned}, not {expected}");
+            // Every sheet ends at two convex corners, the other edge's normal across its own.
+            for sheet in &g.sheets {
+                let own = Vec2::from(sheet.normal);
+                for (k, c) in sheet.corners.iter().enumerate() {
+                    assert!(sheet.hull & CONVEX_BITS == CONVEX_BITS, "{penumbra:?}: a reflex corner");
+                    assert!(Vec2::from(c.at).abs().distance(Vec2::splat(half)) < 1e-3, "corner {k} at {:?}", c.at);
+                    assert!(own.dot(Vec2::from(c.neighbour)).abs() < 1e-3, "corner {k}'s neighbour {:?}", c.neighbour);
+                }
+            }
         }
     }
 

@@ -56,10 +56,12 @@ impl Access {
         access: vk::AccessFlags2::SHADER_SAMPLED_READ,
         layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     };
-    /// Sampled by compute and fragment shaders (color).
-    pub const COMPUTE_FRAGMENT_READ: Access = Access {
+    /// Sampled by compute, vertex and fragment shaders (color).
+    pub const SHADERS_READ: Access = Access {
         stage: vk::PipelineStageFlags2::from_raw(
-            vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw() | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
+            vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw()
+                | vk::PipelineStageFlags2::VERTEX_SHADER.as_raw()
+                | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw(),
         ),
         ..Access::FRAGMENT_READ
     };

@@ -1,0 +1,93 @@
+// Centred plateaus at the hard shadow's corners (issue 20). A sheet takes one edge's line: the
+// light's footprint cut by a half plane, V ½ on the hard edge. Where two edges meet, the truth
+// cuts the footprint by both lines: at a convex corner the shadow is the intersection of the
+// edges' inner sides, and its apex sees ¾ of the light, not ½; at a reflex corner, their union,
+// and the apex ¼. Each side near a corner adds the difference between the two models, both
+// computed with the footprint as the vertex cone's ellipse about the fragment (an affine image
+// of the light's disk, so area fractions are the disk's), and writes the disk-edge distance
+// whose curve gives the sum. Far from the corner (the footprint off the other edge's line) the
+// difference is 0 and the side's own t stands, so the sides still meet without a seam.
+#ifndef SOFTSHADOW_PLATEAU_CORNERS_GLSL
+#define SOFTSHADOW_PLATEAU_CORNERS_GLSL
+#include "disk.glsl"
+
+const float CORNER_PI = 3.14159265358979;
+
+float corner_cross(vec2 a, vec2 b) {
+    return a.x * b.y - a.y * b.x;
+}
+
+// Green's theorem term of the chord of the line u·x = d (u unit) inside the unit disk and the
+// half plane v·x ≥ e, traversed with {u·x ≥ d} on its left: ½ start × end.
+float chord_term(vec2 u, float d, vec2 v, float e) {
+    if (abs(d) >= 1.0) {
+        return 0.0;
+    }
+    vec2 t = vec2(-u.y, u.x), o = u * d;
+    float w = sqrt(1.0 - d * d), lo = -w, hi = w;
+    float vt = dot(v, t), r = e - dot(v, o);
+    if (vt > 0.0) {
+        lo = max(lo, r / vt);
+    } else if (vt < 0.0) {
+        hi = min(hi, r / vt);
+    } else if (r > 0.0) {
+        return 0.0;
+    }
+    return hi > lo ? 0.5 * corner_cross(o + hi * t, o + lo * t) : 0.0;
+}
+
+// The angle of the unit circle inside both half planes u·x ≥ d: two arcs, each about u's
+// angle, acos d either side of it.
+float arcs_inside(vec2 u1, float d1, vec2 u2, float d2) {
+    float h1 = acos(clamp(d1, -1.0, 1.0)), h2 = acos(clamp(d2, -1.0, 1.0));
+    float delta = atan(corner_cross(u1, u2), dot(u1, u2)); // u2's angle from u1's, in [−π, π]
+    float sum = 0.0;
+    for (int k = -1; k <= 1; k++) {
+        float s = delta + 2.0 * CORNER_PI * float(k);
+        sum += max(0.0, min(h1, s + h2) - max(-h1, s - h2));
+    }
+    return sum;
+}
+
+// The fraction of the unit disk in {u1·x ≥ d1} ∩ {u2·x ≥ d2} (u unit): Green's theorem over the
+// region's boundary, its arcs and its two chords.
+float disk_in_both(vec2 u1, float d1, vec2 u2, float d2) {
+    float area = 0.5 * arcs_inside(u1, d1, u2, d2) + chord_term(u1, d1, u2, d2) + chord_term(u2, d2, u1, d1);
+    return clamp(area / CORNER_PI, 0.0, 1.0);
+}
+
+// The disk-edge distance u in [−1, 1] with disk_below(u) = v. With u = sin φ, disk_below is
+// ½ + (φ + ½ sin 2φ)/π: Newton's method on φ from the larger of the two ends' estimates (2φ
+// near 0, π/2 − ∛(1.5 (π/2 − |y|)) near ±π/2), from which it converges from below; two steps
+// leave disk_below(u) within 1e-5 of v.
+float disk_below_inverse(float v) {
+    float y = CORNER_PI * (clamp(v, 0.0, 1.0) - 0.5);
+    float ay = abs(y);
+    float phi = max(0.5 * ay, 0.5 * CORNER_PI - pow(1.5 * max(0.5 * CORNER_PI - ay, 0.0), 1.0 / 3.0));
+    for (int k = 0; k < 2; k++) {
+        float slope = 1.0 + cos(2.0 * phi);
+        phi = slope > 1e-6 ? clamp(phi - (phi + 0.5 * sin(2.0 * phi) - ay) / slope, 0.0, 0.5 * CORNER_PI) : phi;
+    }
+    return sign(y) * sin(phi);
+}
+
+// A corner's two lines in the footprint's disk coordinates x, for the fragment at `p` from the
+// corner's vertex (plane units): the footprint is p − A·x over |x| ≤ 1 (A: the cone's axes),
+// and a line through the vertex with outward normal n hides the light where (Aᵀn)·x ≥ n·p.
+// Returned as (unit u, d) with the shadow side u·x ≥ d; false where the footprint is flat.
+bool footprint_line(mat2 axes, vec2 n, vec2 p, out vec3 line) {
+    vec2 g = transpose(axes) * n;
+    float len = length(g);
+    line = vec3(g / max(len, 1e-30), dot(n, p) / max(len, 1e-30));
+    return len > 0.0 && dot(n, n) > 0.0;
+}
+
+// V under both of a corner's lines (footprint_line), `convex` the turn: at a convex corner the
+// shadow is both inner sides, V = 1 − the disk in both; at a reflex one, either, and V the disk
+// in both outer sides.
+float corner_v(vec3 one, vec3 other, bool convex) {
+    return convex ? 1.0 - disk_in_both(one.xy, one.z, other.xy, other.z)
+                  : disk_in_both(-one.xy, -one.z, -other.xy, -other.z);
+}
+
+#endif
