@@ -327,49 +327,20 @@ impl Sheet {
         Sheet { a: a.into(), b: b.into(), ta: ta.into(), tb: tb.into(), normal: normal.into(), caster, hull, corners }
     }
 
-    /// How far from a corner's vertex the corner can change V on this sheet: where the light's
-    /// footprint about a point reaches past the corner, within a footprint radius (the cone's
-    /// semi-major axis) of it, and the point within the sheet's width of its foot: a foot within
-    /// radius + width of the corner, over sin 60° for a turn of 120°.
-    fn corner_reach(&self, corner: &Corner) -> f32 {
-        let (a, b) = (Vec2::from(self.a), Vec2::from(self.b));
-        let width = (Vec2::from(self.ta) - a).length().max((Vec2::from(self.tb) - b).length());
-        let axes = Mat2::from_cols_array(&corner.axes);
-        1.25 * (axes.col(0).length().max(axes.col(1).length()) + width)
-    }
-
-    /// Whether a corner can change V anywhere on this sheet (or piece: see [`Sheet::pieces`]).
+    /// Whether a corner can change V anywhere on this sheet (a piece, see [`Sheet::pieces`]):
+    /// where the light's footprint about a point reaches past the corner, within a footprint
+    /// radius (the cone's semi-major axis) of it, and the point within the sheet's width of its
+    /// foot: a foot within radius + width of the corner, over sin 60° for a turn of 120°.
     pub fn near_corner(&self) -> bool {
         let (a, b) = (Vec2::from(self.a), Vec2::from(self.b));
+        let width = (Vec2::from(self.ta) - a).length().max((Vec2::from(self.tb) - b).length());
         self.corners.iter().filter(|c| c.neighbour != [0.0; 2]).any(|c| {
+            let axes = Mat2::from_cols_array(&c.axes);
+            let radius = axes.col(0).length().max(axes.col(1).length());
             let at = Vec2::from(c.at);
             let along = (at - a).dot(b - a) / (b - a).length_squared().max(f32::MIN_POSITIVE);
-            at.distance(a.lerp(b, along.clamp(0.0, 1.0))) <= self.corner_reach(c)
+            at.distance(a.lerp(b, along.clamp(0.0, 1.0))) <= 1.25 * (radius + width)
         })
-    }
-
-    /// The whole edge's sheet cut where its corners stop reaching ([`Sheet::corner_reach`]):
-    /// the part within reach of each corner keeps that corner alone, the part between none. The
-    /// sides near corners are drawn apart at a cost per fragment (`CORNERS`,
-    /// `glsl/plateau/penumbra.frag`), which a long edge's middle need not pay. An edge whose
-    /// corners reach over all of it stays whole.
-    pub fn corner_parts(&self) -> Vec<Sheet> {
-        let length = (Vec2::from(self.b) - Vec2::from(self.a)).length();
-        let reach = self.corners.map(|c| if c.neighbour == [0.0; 2] { 0.0 } else { self.corner_reach(&c) / length });
-        let (s0, s1) = (reach[0], 1.0 - reach[1]);
-        // Not where the reaches overlap, nor a zero-length edge's (NaN), nor without corners.
-        let apart = s0 < s1 && (s0 > 0.0 || s1 < 1.0);
-        if !apart {
-            return vec![*self];
-        }
-        let [first, second] = self.corners;
-        // Where it stands, with no other edge: no corner there.
-        let [first_off, second_off] = self.corners.map(|c| Corner { neighbour: [0.0; 2], ..c });
-        [(0.0, s0, [first, second_off]), (s0, s1, [first_off, second_off]), (s1, 1.0, [first_off, second])]
-            .into_iter()
-            .filter(|(from, to, _)| to > from)
-            .map(|(from, to, corners)| Sheet { corners, ..self.part(from, to) })
-            .collect()
     }
 
     /// The sheet with its edge's corners (at a, at b) and whether the shadow is convex there.
@@ -402,14 +373,12 @@ impl Sheet {
     /// sample every texel.
     pub fn pieces(&self, n: u32) -> impl Iterator<Item = Sheet> + '_ {
         let n = n.max(1);
-        (0..n).map(move |k| self.part(k as f32 / n as f32, (k + 1) as f32 / n as f32))
-    }
-
-    /// The patch over s0..s1, with the whole edge's corners.
-    fn part(&self, s0: f32, s1: f32) -> Sheet {
-        let [a, b, ta, tb] = [(s0, 0.0), (s1, 0.0), (s0, 1.0), (s1, 1.0)].map(|(s, t)| self.point(s, t));
-        let piece = Sheet::new(a, b, ta, tb, self.normal.into(), self.caster);
-        Sheet { hull: piece.hull | self.hull & CONVEX_BITS, corners: self.corners, ..piece }
+        (0..n).map(move |k| {
+            let [s0, s1] = [k, k + 1].map(|k| k as f32 / n as f32);
+            let [a, b, ta, tb] = [(s0, 0.0), (s1, 0.0), (s0, 1.0), (s1, 1.0)].map(|(s, t)| self.point(s, t));
+            let piece = Sheet::new(a, b, ta, tb, self.normal.into(), self.caster);
+            Sheet { hull: piece.hull | self.hull & CONVEX_BITS, corners: self.corners, ..piece }
+        })
     }
 
     /// The plateau parameter at `p` and the hard edge's parameter s of its foot: the smallest t
@@ -1494,10 +1463,6 @@ mod tests {
                     assert!(Vec2::from(c.at).abs().distance(Vec2::splat(half)) < 1e-3, "corner {k} at {:?}", c.at);
                     assert!(own.dot(Vec2::from(c.neighbour)).abs() < 1e-3, "corner {k}'s neighbour {:?}", c.neighbour);
                 }
-                // Cut where the corners stop reaching: the middle far from both.
-                let parts = sheet.corner_parts();
-                let near: Vec<bool> = parts.iter().map(Sheet::near_corner).collect();
-                assert_eq!(near, [true, false, true], "{penumbra:?}: {parts:?}");
             }
         }
     }

@@ -486,8 +486,7 @@ impl Technique for Plateau {
             // A sample of the mask every texel along each centred sheet's hard edge.
             let texels = Vec2::splat(tex_size as f32) / Vec2::new(window.z - window.x, window.w - window.y);
             let pieces = |s: &Sheet| ((Vec2::from(s.b) - Vec2::from(s.a)) * texels).length() / SHEET_SAMPLES as f32;
-            let parts = geometry.sheets.iter().flat_map(Sheet::corner_parts);
-            geometry.sheets = parts.flat_map(|s| s.pieces(pieces(&s).ceil() as u32).collect::<Vec<_>>()).collect();
+            geometry.sheets = geometry.sheets.iter().flat_map(|s| s.pieces(pieces(s).ceil() as u32)).collect();
             // The sides near corners last, drawn apart (`CORNERS`): llvmpipe runs a fragment
             // shader's every branch, and the corners' arithmetic on every fragment cost low_light's
             // sheets 3.7 → 27 ms.
