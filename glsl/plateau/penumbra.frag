@@ -157,7 +157,12 @@ float wedge_corner_gain(vec2 y, float t, out float side) {
 // rasterised edge and the side's line part by a texel (a sharp spike's sliver) the side's sign
 // flipped single pixels between lit and umbra. Where nothing is added, t itself.
 float with_corner(float t, float side, float gain, bool own) {
-    return gain == 0.0 ? t : (own ? -1.0 : 1.0) * disk_below_inverse(disk_below(side * t) + gain);
+    // A gain is a difference of two fractions of the light: anything else (a NaN from a
+    // footprint too large for f32) adds nothing.
+    if (!(abs(gain) <= 1.0) || gain == 0.0) {
+        return t;
+    }
+    return (own ? -1.0 : 1.0) * disk_below_inverse(disk_below(side * t) + gain);
 }
 
 // Centred: whether this side writes here (its foot on the hard shadow's boundary, or an
