@@ -97,49 +97,44 @@ fn sees_at_the_corner(s: &Scene, truth: std::ops::RangeInclusive<f32>) {
     assert!(worst <= 0.06, "V up to {worst} off the reference");
 }
 
-/// An L-shaped slab (two 2 × 1 m arms, 2 cm thick), 1 m up, written as an OBJ file: its
-/// outline's one reflex vertex at the origin, the light 6 m up at (−2.5, −2.5) (radius 0.5), so
-/// that its hard shadow's reflex corner falls at (0.5, 0.5), in the quadrant the slab leaves
-/// open, seen from above 0.4 m each way. The corner sees about a quarter of the light (a right
-/// angle seen a little obliquely), where either sheet alone says ½, and around it the sides
-/// follow the reference within 0.06.
+/// An L-shaped slab (two 2 × 1 m arms, 2 cm thick), 1 m up: its outline's one reflex vertex at
+/// the origin, the light 6 m up at (−2.5, −2.5) (radius 0.5), so that its hard shadow's reflex
+/// corner falls at (0.5, 0.5), in the quadrant the slab leaves open, seen from above 0.4 m each
+/// way. The corner sees about a quarter of the light (a right angle seen a little obliquely),
+/// where either sheet alone says ½, and around it the sides follow the reference within 0.06.
 #[test]
 fn an_l_shaped_slab_s_reflex_corner_sees_a_quarter_of_the_light() {
-    // The outline anticlockwise in (x, z), the reflex vertex (1, 1) moved to the origin.
+    use glam::Vec3;
+    // The outline anticlockwise in (x, z), the reflex vertex (1, 1) moved to the origin; each
+    // triangle wound so that its normal points along `out` (Mesh::new welds equal positions).
     let outline =
         [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)].map(|(x, z)| (x - 1.0, z - 1.0));
-    let vertex = |(x, z): (f32, f32), y: f32| glam::Vec3::new(x, y, z);
-    let mut triangles = Vec::new();
-    // Each triangle wound so that its normal points along `out`.
-    let mut face = |p: [glam::Vec3; 3], out: glam::Vec3| {
+    let vertex = |(x, z): (f32, f32), y: f32| Vec3::new(x, y, z);
+    let mut positions = Vec::new();
+    let mut face = |p: [Vec3; 3], out: Vec3| {
         let flip = (p[1] - p[0]).cross(p[2] - p[0]).dot(out) < 0.0;
-        triangles.push(if flip { [p[0], p[2], p[1]] } else { p });
+        positions.extend(if flip { [p[0], p[2], p[1]] } else { p });
     };
     for k in 1..outline.len() - 1 {
         let [a, b, c] = [outline[0], outline[k], outline[k + 1]];
-        face([a, b, c].map(|q| vertex(q, 0.01)), glam::Vec3::Y);
-        face([a, b, c].map(|q| vertex(q, -0.01)), -glam::Vec3::Y);
+        face([a, b, c].map(|q| vertex(q, 0.01)), Vec3::Y);
+        face([a, b, c].map(|q| vertex(q, -0.01)), -Vec3::Y);
     }
     for k in 0..outline.len() {
         let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
-        let out = glam::Vec3::new(b.1 - a.1, 0.0, a.0 - b.0);
+        let out = Vec3::new(b.1 - a.1, 0.0, a.0 - b.0);
         face([vertex(a, 0.01), vertex(b, 0.01), vertex(b, -0.01)], out);
         face([vertex(a, 0.01), vertex(b, -0.01), vertex(a, -0.01)], out);
     }
-    // One vertex per corner of each triangle: the mesh loader welds equal positions.
-    let mut obj = String::new();
-    for t in &triangles {
-        t.iter().for_each(|v| obj += &format!("v {} {} {}\n", v.x, v.y, v.z));
-    }
-    (0..triangles.len()).for_each(|i| obj += &format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3));
-    let path = std::env::temp_dir().join(format!("softshadow_l_slab_{}.obj", std::process::id()));
-    std::fs::write(&path, obj).expect("the slab's OBJ file");
-    let s = scene(&format!(
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    let slab = softshadow::scene::Mesh::new("L-shaped slab", positions, triangles).expect("a closed slab");
+    // A box placed where the slab goes, its mesh then swapped for the slab's.
+    let mut s = scene(
         "[camera]\nposition = [0.5, 12.0, 0.5]\ntarget = [0.5, 0.0, 0.5]\nup = [0.0, 0.0, -1.0]\n\
          ortho_half_height = 0.4\n[light]\nposition = [-2.5, 6.0, -2.5]\nradius = 0.5\n[ground]\nheight = 0.0\n\
-         [[object]]\nshape = \"mesh\"\nmesh = {path:?}\nposition = [0.0, 1.0, 0.0]\n"
-    ));
-    std::fs::remove_file(&path).ok();
+         [[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nposition = [0.0, 1.0, 0.0]\n",
+    );
+    s.objects[0].mesh = std::sync::Arc::new(slab);
     sees_at_the_corner(&s, 0.15..=0.35);
 }
 

@@ -62,9 +62,10 @@
 //! shadow's outline, not along every light-facing polygon's edges (`edges = 1`), which mostly
 //! lay inside it and were probed away. The centred probes read the mask's outward side first,
 //! which decides alone on the hard shadow's boundary, and with a single caster skip the texel
-//! under the fragment. Each sheet and each quarter-turn piece of a wedge is one record (112 and 64
-//! bytes with their corners; 48 before them) in a storage buffer, which the vertex shader expands (a sheet's hull, a wedge's three
-//! triangles) and whose exact t the fragment shader solves: the CPU no longer tessellates
+//! under the fragment. Each sheet and each quarter-turn piece of a wedge is one record (112
+//! and 64 bytes with their corners; 48 before them) in a storage buffer, which the vertex
+//! shader expands (a sheet's hull, a wedge's three triangles) and whose exact t the fragment
+//! shader solves: the CPU no longer tessellates
 //! (koala, a moving frame, one thread: 5.6 ms before, 2.2 ms after, with facing from the mesh's
 //! face planes and only the edges' vertices transformed). On lavapipe the per-fragment root
 //! costs the sheets more than the vertices saved (koala 24 → 30 ms, hammer 60 → 90 ms at 512²),
@@ -424,6 +425,15 @@ impl Plateau {
     }
 }
 
+/// Moves the sides `near` a corner after the others, each kind in its order, and counts both:
+/// [others, near].
+fn near_last<T: Copy>(sides: &mut Vec<T>, near: impl Fn(&T) -> bool) -> [u32; 2] {
+    let (close, far): (Vec<T>, Vec<T>) = sides.iter().partition(|s| near(s));
+    let counts = [far.len() as u32, close.len() as u32];
+    *sides = [far, close].concat();
+    counts
+}
+
 /// The part of the plane a texture of `size` texels covers: `footprint` and two texels of
 /// margin, which keep its rim inside.
 fn window((lo, hi): (Vec2, Vec2), size: u32) -> Vec4 {
@@ -487,16 +497,15 @@ impl Technique for Plateau {
             let texels = Vec2::splat(tex_size as f32) / Vec2::new(window.z - window.x, window.w - window.y);
             let pieces = |s: &Sheet| ((Vec2::from(s.b) - Vec2::from(s.a)) * texels).length() / SHEET_SAMPLES as f32;
             geometry.sheets = geometry.sheets.iter().flat_map(|s| s.pieces(pieces(s).ceil() as u32)).collect();
-            // The sides near corners last, drawn apart (`CORNERS`): llvmpipe runs a fragment
-            // shader's every branch, and the corners' arithmetic on every fragment cost low_light's
-            // sheets 3.7 → 27 ms.
-            geometry.sheets.sort_by_key(Sheet::near_corner);
-            geometry.cones.sort_by_key(Wedge::at_corner);
         }
-        let cornered = |n: usize, near: usize| [(n - near) as u32, near as u32];
-        let cornered_sheets =
-            cornered(geometry.sheets.len(), geometry.sheets.iter().filter(|s| s.near_corner()).count());
-        let cornered_cones = cornered(geometry.cones.len(), geometry.cones.iter().filter(|w| w.at_corner()).count());
+        // Centred, the sides near corners go last, drawn apart (`CORNERS`): llvmpipe runs a
+        // fragment shader's every branch, and the corners' arithmetic on every fragment cost
+        // low_light's sheets 3.7 → 27 ms. How many of each kind: [plain, near corners].
+        let (sheet_kinds, cone_kinds) = if centred {
+            (near_last(&mut geometry.sheets, Sheet::near_corner), near_last(&mut geometry.cones, Wedge::at_corner))
+        } else {
+            ([geometry.sheets.len() as u32, 0], [geometry.cones.len() as u32, 0])
+        };
 
         let scale = Vec2::new(2.0 / (window.z - window.x), 2.0 / (window.w - window.y));
         let to_clip = Mat4::from_cols(
@@ -584,8 +593,7 @@ impl Technique for Plateau {
         // Per primitive, a wedge's three triangles or a sheet's two (see penumbra.vert); partial
         // silhouettes' sheets in the sheets' pass, after them.
         // Centred, the sides near corners after the others, with the corners' code.
-        let [plain_sheets, corner_sheets] = if centred { cornered_sheets } else { [sheets, 0] };
-        let [plain_cones, corner_cones] = if centred { cornered_cones } else { [cones, 0] };
+        let ([plain_sheets, corner_sheets], [plain_cones, corner_cones]) = (sheet_kinds, cone_kinds);
         let sheet_draws = [
             (Side::Sheet, false, 6 * cones, 6 * plain_sheets),
             (Side::Sheet, true, 6 * (cones + plain_sheets), 6 * corner_sheets),
