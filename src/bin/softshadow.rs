@@ -570,7 +570,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
     }
     use softshadow::measure::bench::{
         BenchRow, leak_goals, load_reference, mark_pareto, registry_cost_goals, round_frames, save_reference,
-        setting_label, sweep, write_csv, write_report,
+        setting_label, sweep, timing_order, write_csv, write_report,
     };
     let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
     let scenes: Vec<PathBuf> = if !args.scenes.is_empty() {
@@ -601,6 +601,8 @@ fn bench(args: &BenchArgs) -> Result<()> {
         .into_iter()
         .filter(|(t, _)| args.techniques.is_empty() || args.techniques.iter().any(|n| n == t.name))
         .collect();
+    let goals: Vec<_> = registry_cost_goals().into_iter().chain(leak_goals()).collect();
+    let order = timing_order(&runs, &goals);
     let size = if args.quick { 128 } else { 512 };
     let cache = args.out.join("cache");
     std::fs::create_dir_all(&cache).with_context(|| format!("creating {}", cache.display()))?;
@@ -647,15 +649,18 @@ fn bench(args: &BenchArgs) -> Result<()> {
                 settings.params.apply(sets.iter().copied()).map(|_| settings)
             })
             .collect::<std::result::Result<_, _>>()?;
-        // Real-time rows in interleaved rounds (measure::bench::ROUNDS), the last captured;
-        // offline ones once, with the first.
+        // Real-time rows in interleaved rounds (measure::bench::ROUNDS), the last captured, each
+        // goal's rows side by side (timing_order); offline ones once, with the first.
         let mut measured = vec![Vec::new(); runs.len()];
         let mut round_ms = vec![Vec::new(); runs.len()];
         let mut captures = vec![None; runs.len()];
         let rounds = round_frames(args.frames);
         for (round, &frames) in rounds.iter().enumerate() {
             let last = round + 1 == rounds.len();
-            for (i, &(info, sets)) in runs.iter().enumerate() {
+            // Odd rounds backwards (timing_order).
+            let n = order.len();
+            for i in (0..n).map(|k| order[if round % 2 == 0 { k } else { n - 1 - k }]) {
+                let (info, sets) = runs[i];
                 let offline = info.kind.offline();
                 if offline && round > 0 {
                     continue;
@@ -707,7 +712,7 @@ fn bench(args: &BenchArgs) -> Result<()> {
     write_csv(&rows, &args.out.join("results.csv"))?;
     write_report(&rows, &reference, &args.out.join("report.md"))?;
     softshadow::measure::tradeoff(&rows, &args.out.join("tradeoff.png"))?;
-    registry_cost_goals().iter().chain(&leak_goals()).filter_map(|g| g.outcome(&rows)).for_each(|line| out!("{line}"));
+    goals.iter().filter_map(|g| g.outcome(&rows)).for_each(|line| out!("{line}"));
     if let (Some(trace), Some(p)) = (trace, &args.trace) {
         trace.finish()?;
         out!("wrote {}", p.display());

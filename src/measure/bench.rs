@@ -50,6 +50,40 @@ pub fn round_frames(frames: usize) -> Vec<usize> {
     (0..rounds).map(|r| frames / rounds + usize::from(r < frames % rounds)).collect()
 }
 
+/// The order a round renders `runs` in: each goal's row beside its baseline's (within three
+/// rows for the registry's goals), the rest after. A round of a scene takes about half a
+/// minute; rows swept apart met different minutes of a shared machine, and a pair's ratio moved
+/// by up to 2× from round to round (smoothie against the 1024² map on `contact`: 0.78–1.81)
+/// while an identical prepass moved as much. Rows a second apart see the same minute, so a
+/// ratio measures the techniques, not the machine. Odd rounds run the order backwards, so a
+/// steady drift in speed favours neither side of a pair.
+pub fn timing_order(runs: &[(&'static TechniqueInfo, Setting)], goals: &[Goal]) -> Vec<usize> {
+    let find = |t: &str, s: &str| (0..runs.len()).find(|&i| runs[i].0.name == t && setting_label(runs[i].1) == s);
+    let pairs: Vec<(usize, usize)> = goals
+        .iter()
+        .filter_map(|g| Some((find(g.technique, &g.setting)?, find(g.baseline, &g.baseline_setting)?)))
+        .collect();
+    // Depth first through the goals' graph: a row, then each row it is compared with.
+    fn visit(i: usize, pairs: &[(usize, usize)], order: &mut Vec<usize>) {
+        if order.contains(&i) {
+            return;
+        }
+        order.push(i);
+        for &(a, b) in pairs {
+            if a == i {
+                visit(b, pairs, order);
+            } else if b == i {
+                visit(a, pairs, order);
+            }
+        }
+    }
+    let mut order = Vec::with_capacity(runs.len());
+    for i in pairs.iter().map(|p| p.0).chain(0..runs.len()) {
+        visit(i, &pairs, &mut order);
+    }
+    order
+}
+
 /// `key=value` pairs separated by spaces, as [`BenchRow::setting`] holds them.
 pub fn setting_label(setting: Setting) -> String {
     setting.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>().join(" ")
@@ -267,8 +301,9 @@ fn round_ratios(of: &BenchRow, base: &BenchRow) -> Option<(f64, f64)> {
 }
 
 /// Headings of the report's goal tables.
-pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run; ✓ where the goal holds; in \
-     brackets the least and the greatest of the same ratio within one round, how far this machine's noise moved it.";
+pub const COST_HEADING: &str = "## Cost goals\n\nRatios of median GPU ms within this run, each goal's two rows timed side \
+     by side in every round; ✓ where the goal holds; in brackets the least and the greatest of the same ratio within \
+     one round, how far this machine's noise moved it.";
 pub const LEAK_HEADING: &str = "## Leak rule\n\nLight-leak rates (V above the reference by more than 0.1), the centred \
      default against the papers' outer-only form; ✓ where it leaks no more. In brackets the pixels below the \
      reference by more than 0.1, which the outer-only form's whole-umbra hard shadow trades its leaks for.";
@@ -485,6 +520,26 @@ mod tests {
             assert_eq!(rounds.iter().sum::<usize>(), frames);
             assert_eq!(rounds.len(), ROUNDS.min(frames));
             assert!(rounds.iter().all(|&n| n >= 1 && n + 1 >= rounds[0]), "{frames}: {rounds:?}");
+        }
+    }
+
+    /// Every row is timed once a round, and each goal's two rows are rendered within three
+    /// rows of each other: a second apart, not half a minute.
+    #[test]
+    fn a_round_times_each_goal_s_rows_side_by_side() {
+        let runs = sweep(false);
+        let goals: Vec<Goal> = registry_cost_goals().into_iter().chain(leak_goals()).collect();
+        let order = timing_order(&runs, &goals);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..runs.len()).collect::<Vec<_>>(), "every row once");
+        let place = |t: &str, s: &str| {
+            let i = runs.iter().position(|(r, rs)| r.name == t && setting_label(rs) == s).expect("benched");
+            order.iter().position(|&o| o == i).expect("ordered") as isize
+        };
+        for g in &goals {
+            let apart = (place(g.technique, &g.setting) - place(g.baseline, &g.baseline_setting)).abs();
+            assert!(apart <= 3, "{}: {apart} rows apart", g.label());
         }
     }
 
