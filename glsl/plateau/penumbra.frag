@@ -36,19 +36,17 @@ layout(location = 0) in vec2 in_local;
 layout(location = 1) in vec2 in_uv;
 layout(location = 2) flat in vec4 in_shape0;
 layout(location = 3) flat in vec4 in_shape1;
-layout(location = 4) flat in vec2 in_edge;
-layout(location = 5) flat in vec2 in_normal;
-layout(location = 6) flat in uint in_caster;
+layout(location = 4) flat in uint in_caster;
 // Centred sheets: what the vertices probed along the hard edge (penumbra.vert), and at how
 // many samples.
-layout(location = 7) flat in uvec4 in_probes;
-layout(location = 8) flat in uint in_samples;
+layout(location = 5) flat in uvec4 in_probes;
+layout(location = 6) flat in uint in_samples;
 // Centred, the corners (penumbra.vert, corners.glsl).
-layout(location = 9) flat in vec4 in_corner0;
-layout(location = 10) flat in vec4 in_axes0;
-layout(location = 11) flat in vec4 in_corner1;
-layout(location = 12) flat in vec4 in_axes1;
-layout(location = 13) flat in vec4 in_turns;
+layout(location = 7) flat in vec4 in_corner0;
+layout(location = 8) flat in vec4 in_axes0;
+layout(location = 9) flat in vec4 in_corner1;
+layout(location = 10) flat in vec4 in_axes1;
+layout(location = 11) flat in vec4 in_turns;
 // The plateau parameter, signed (−1 .. 1: centred corners write below 0, corners.glsl) and
 // stored as ½ + ½·t in the unsigned texture; the resolve reads it back.
 layout(location = 0) out vec2 out_t;
@@ -186,8 +184,8 @@ bool centred_t(float t, float s, out vec2 written) {
         uint k = min(uint(s * float(in_samples)), in_samples - 1u);
         boundary = probed(in_probes.xy, k);
         own_both = probed(in_probes.zw, k);
-        vec2 from_foot = in_uv - (in_shape1.zw + s * in_edge);
-        outer_half = dot(from_foot, in_normal) > 0.0;
+        vec2 from_foot = in_local - s * in_shape0.xy;
+        outer_half = dot(from_foot, in_turns.xy) > 0.0;
     } else {
         // A cone's foot is its apex, and its normal at this pixel the direction from there.
         vec2 size = vec2(textureSize(mask, 0));

@@ -39,21 +39,19 @@ layout(location = 1) out vec2 out_uv;
 // - | -, the apex in texture coordinates.
 layout(location = 2) flat out vec4 out_shape0;
 layout(location = 3) flat out vec4 out_shape1;
-// The hard edge's direction b − a in texture coordinates (wedges: 0).
-layout(location = 4) flat out vec2 out_edge;
-layout(location = 5) flat out vec2 out_normal;
-layout(location = 6) flat out uint out_caster;
+layout(location = 4) flat out uint out_caster;
 // Centred sheets: their mask probes along the hard edge (probes.comp), for the fragments.
-layout(location = 7) flat out uvec4 out_probes;
-layout(location = 8) flat out uint out_samples;
+layout(location = 5) flat out uvec4 out_probes;
+layout(location = 6) flat out uint out_samples;
 // Centred, the corners (corners.glsl): per corner, its vertex from the primitive's origin (a
 // sheet's a, a wedge's apex) and the other edge's normal | the footprint's axes; the sheet's
-// own normal, 1 where convex at each corner (wedges: their one corner, both normals).
-layout(location = 9) flat out vec4 out_corner0;
-layout(location = 10) flat out vec4 out_axes0;
-layout(location = 11) flat out vec4 out_corner1;
-layout(location = 12) flat out vec4 out_axes1;
-layout(location = 13) flat out vec4 out_turns;
+// own outward normal (plane units, which also tell the fragments its outer half), 1 where
+// convex at each corner (wedges: their one corner, both normals).
+layout(location = 7) flat out vec4 out_corner0;
+layout(location = 8) flat out vec4 out_axes0;
+layout(location = 9) flat out vec4 out_corner1;
+layout(location = 10) flat out vec4 out_axes1;
+layout(location = 11) flat out vec4 out_turns;
 
 // Whether the hard shadow about a corner at `at` (plane units) is what its two lines (outward
 // normals `one`, `other`) say: the mask PROBE texels out along the four bisectors of the lines,
@@ -95,8 +93,6 @@ void main() {
         out_local = p - a;
         out_shape0 = vec4(r0.zw - a, r1.xy - a);
         out_shape1 = vec4(r1.zw - a, (a - plateau.window.xy) / extent);
-        out_edge = (r0.zw - a) / extent;
-        out_normal = r2.xy / extent;
         out_caster = uint(r2.z);
         vec4 r4 = sides[record + 4u], r5 = sides[record + 5u], r6 = sides[record + 6u];
         uint convex = floatBitsToUint(r2.w) >> 12u;
@@ -131,8 +127,6 @@ void main() {
         out_local = y;
         out_shape0 = vec4(lean, 0.0, 0.0);
         out_shape1 = vec4(0.0, 0.0, (apex - plateau.window.xy) / extent);
-        out_edge = vec2(0.0);
-        out_normal = vec2(0.0);
         out_caster = uint(r2.z);
         out_corner0 = vec4(0.0, 0.0, r3.xy);
         out_axes0 = r1;
