@@ -51,12 +51,13 @@ pub fn round_frames(frames: usize) -> Vec<usize> {
 }
 
 /// The order a round renders `runs` in: each goal's row beside its baseline's (within three
-/// rows for the registry's goals), the rest after. A round of a scene takes about half a
-/// minute; rows swept apart met different minutes of a shared machine, and a pair's ratio moved
-/// by up to 2× from round to round (smoothie against the 1024² map on `contact`: 0.78–1.81)
-/// while an identical prepass moved as much. Rows a second apart see the same minute, so a
-/// ratio measures the techniques, not the machine. Odd rounds run the order backwards, so a
-/// steady drift in speed favours neither side of a pair.
+/// rows for the registry's goals), the rest after. A round of a scene takes 10–20 s on
+/// lavapipe; rows swept apart met different phases of a shared machine, and a pair's ratio
+/// moved by up to 2× from round to round (smoothie against the 1024² map on `contact`:
+/// 0.78–1.81) while an identical prepass moved as much. Rows side by side share more of them.
+/// It narrows the spread, not removes it: the machine also changes speed within a second (the
+/// same pair, adjacent: 1.16–1.63 in one run). Odd rounds run the order backwards, so a steady
+/// drift in speed favours neither side of a pair.
 pub fn timing_order(runs: &[(&'static TechniqueInfo, Setting)], goals: &[Goal]) -> Vec<usize> {
     let find = |t: &str, s: &str| (0..runs.len()).find(|&i| runs[i].0.name == t && setting_label(runs[i].1) == s);
     let pairs: Vec<(usize, usize)> = goals
