@@ -525,7 +525,7 @@ mod tests {
     }
 
     /// Every row is timed once a round, and each goal's two rows are rendered within three
-    /// rows of each other: a second apart, not half a minute.
+    /// rows of each other: about a second apart, not up to a whole round (10–20 s).
     #[test]
     fn a_round_times_each_goal_s_rows_side_by_side() {
         let runs = sweep(false);
