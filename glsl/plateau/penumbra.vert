@@ -107,7 +107,7 @@ void main() {
             out_corner1.zw *= float(corner_holds(r5.xy, r2.xy, r5.zw, out_turns.w > 0.5));
         }
         if (CENTRED && !PARTIAL) {
-            SheetProbes probed = probes[uint(gl_VertexIndex) / per - plateau.sheets.x];
+            SheetProbes probed = probes[primitive - plateau.sheets.x];
             out_probes = probed.bits;
             out_samples = probed.samples.x;
             if (probed.samples.y != 0u) {

@@ -704,7 +704,7 @@ pub fn plateau_sides(
         let (e0, e1) = (g[0].1 as usize, g[1].1 as usize);
         (other_end[e0], other_end[e1]) = (Some(e1), Some(e0));
     }
-    let corner = |end: usize| -> Option<(Corner, bool)> {
+    let corner_at = |end: usize| -> Option<(Corner, bool)> {
         let (mine, theirs) = (normals[end / 2]?, normals[other_end[end]? / 2]?);
         let (at, far) = (cone(end)?, cone(end ^ 1)?);
         let beyond = cone(other_end[end]? ^ 1)?.centre;
@@ -717,6 +717,8 @@ pub fn plateau_sides(
             (corner, theirs.dot(far.centre - at.centre) < 0.0)
         })
     };
+    // Once per end: the end's edge and its vertex's wedges both take it.
+    let corners: Vec<Option<(Corner, bool)>> = (0..ends.len()).into_par_iter().map(corner_at).collect();
     // Chunks of edges, then of vertices, in parallel (rayon), put together in order.
     let parts: Vec<(PlateauGeometry, Vec<Covers>)> = edges
         .par_chunks(PARALLEL_CHUNK)
@@ -730,7 +732,7 @@ pub fn plateau_sides(
                     covers.extend([[None; 2]; 2]);
                     continue;
                 };
-                let corners = [corner(2 * i), corner(2 * i + 1)];
+                let corners = [corners[2 * i], corners[2 * i + 1]];
                 covers.extend(edge_sheets(&mut out, light.penumbra, (ca, cb), normal, corners, number));
             }
             (out, covers)
@@ -754,7 +756,7 @@ pub fn plateau_sides(
                 out.grow(cone.centre);
                 let covered = group.iter().flat_map(|(_, end)| covers[*end as usize]).flatten();
                 // The corner seen from its first edge: both normals, and the turn.
-                let corner = corner(end).and_then(|(c, convex)| {
+                let corner = corners[end].and_then(|(c, convex)| {
                     Some(WedgeCorner { normals: (normals[end / 2]?, c.neighbour.into()), convex })
                 });
                 vertex_wedges(&mut out, &cone, light, covered, (&mut arcs, &mut gaps), (number, corner));
