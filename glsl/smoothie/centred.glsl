@@ -100,8 +100,8 @@ bool centred_fragment(out Centred c) {
         if (CORNERS) {
             // The receiver taken behind the blocker: what is cast just outside the edge, which
             // the inner half holds down to (the limit), else the ground. With the ground alone,
-            // overlap's upper plate's corner on the lower plate took the ground's footprint, far
-            // wider than the lower plate's (97 px leaking 0.14).
+            // overlap's upper plate's corner on the lower plate took a footprint 4× too wide
+            // there (97 px leaking 0.14).
             c.alpha = corner_alpha(alpha, min(outside, ground_depth(light, uv)), true);
         }
         return own && (outside >= light.kernel.y || outside > in_range.y + slack);
