@@ -1,7 +1,7 @@
 #version 460
 // Beyond the paper (which found silhouettes on the host, §4): silhouette detection and
 // smoothie generation on the GPU, one invocation per edge, appended into a vertex buffer whose
-// counts feed four indirect draws. Same construction as src/geometry/smoothie.rs.
+// counts feed two indirect draws. Same construction as src/geometry/smoothie.rs.
 #include "interface.glsl"
 
 layout(local_size_x = 64) in;
