@@ -52,19 +52,6 @@
 //! turned face (lit, or another receiver, which a partial silhouette shadows as it does the
 //! ground), and the resolve lets them darken only receivers behind the turned face.
 //!
-//! Corners, centred (`geometry::smoothie::ShadowCorner`): where two edges of the hard shadow's
-//! outline turn, the truth cuts the light's footprint by both lines, ¾ of the light at a right
-//! convex apex and ¼ at a reflex one, where each smoothie alone says ½. As the plateau's sides
-//! do, the pieces of the edges' quads and the wedges within reach of such a corner carry it, and
-//! the smoothie pass writes the alpha whose curve gives V under both lines, the footprint the
-//! disk of radius t·(1 − b/r) about the fragment (`glsl/smoothie/centred.glsl`); they are drawn
-//! apart (`Part`), as llvmpipe runs every branch. Measured (bench, 512², lavapipe, against the
-//! reference, one run each), penumbra RMSE before → after: plate 0.0275 → 0.0104, open_mesh
-//! 0.031 → 0.0090, overlap 0.042 → 0.0103, two_boxes 0.047 → 0.029, contact 0.035 → 0.025, the
-//! suite's median 0.0275 → 0.0120, no scene worse by over 0.0005 and no leaking pixel more; the
-//! smoothie pass, interleaved runs of 30 frames: plate 0.56–0.59 → 1.17–1.28 ms, overlap
-//! 1.5 → 3.5–3.8, contact 2.7–3.0 → 4.7–4.9, default 3.5–3.8 → 5.2–5.6.
-//!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard
 //! edge the penumbra straddles is the silhouettes' own edge. Only the camera draws the full mesh.
