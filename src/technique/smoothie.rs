@@ -86,8 +86,8 @@ use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::silhouette::{Caster, EdgeSource, PartialEdge, partial_silhouettes, penumbra_edges};
 use crate::geometry::smoothie::{
-    Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, depth_range, merged_silhouette, merged_smoothies,
-    partial_smoothies, smoothies,
+    Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, SmoothieVertex, depth_range, merged_silhouette,
+    merged_smoothies, partial_smoothies, smoothies,
 };
 use crate::geometry::{Aabb, LightFrustum, any_two_meet};
 use crate::gpu::{
@@ -654,7 +654,7 @@ impl Technique for Smoothie {
             let tolerance = params.get(&MERGE) as f32 * (x1 - x0).max(y1 - y0) / buffer_size as f32;
             let (geometry, windows) =
                 self.geometry(frame, &cast, &frustum, (smoothie_size, receivers), (centred, tolerance));
-            let (vertices, counts) = geometry.drawn();
+            let vertices: Vec<SmoothieVertex> = geometry.vertices().copied().collect();
             let bytes: &[u8] = cast_slice(&vertices);
             let source = if bytes.is_empty() {
                 Smoothies::None
@@ -662,7 +662,8 @@ impl Technique for Smoothie {
                 let usage = vk::BufferUsageFlags::VERTEX_BUFFER;
                 let v = PerFrame::ensure(ctx, &mut self.vertices, "smoothies", bytes.len() as u64, usage)?;
                 v.write(frame.slot, bytes);
-                Smoothies::Direct { vertices: v.range(frame.slot), counts }
+                let outer = geometry.outer_vertices() as u32;
+                Smoothies::Direct { vertices: v.range(frame.slot), outer, inner: vertices.len() as u32 - outer }
             };
             (source, windows)
         };
@@ -678,13 +679,9 @@ impl Technique for Smoothie {
         }
         let draws = source.draws(layout.centred());
         let make = |&(layout, part): &(Buffer, Part)| {
-            let constants = if layout.centred() {
-                vec![("INNER", u32::from(part.inner)), ("CORNERS", u32::from(part.corners))]
-            } else {
-                Vec::new()
-            };
+            let constants = if layout.centred() { vec![("INNER", u32::from(part == Part::Inner))] } else { Vec::new() };
             let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, layout.fragment_shader())
-                .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1, 2, 4, 1, 1, 2]))
+                .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1]))
                 .colors(formats)
                 .constants(&constants)
                 .blend(Blend::Min);
@@ -841,13 +838,14 @@ pub(super) fn penumbra(centred: bool, view: &Mat4, bounds: &Aabb) -> Penumbra {
 
 /// Where this frame's smoothie vertices are.
 enum Smoothies {
-    /// The CPU path's, one range after the other, as many vertices as `counts` gives each
-    /// [`Part`] (in the order of [`Part::ALL`]).
+    /// The CPU path's: `outer` vertices of outer smoothies, then `inner` of inner quads.
     Direct {
         vertices: vk::DescriptorBufferInfo,
-        counts: [u32; 4],
+        outer: u32,
+        inner: u32,
     },
-    /// The compute path's: an indirect draw per [`Part`], one after the other in `args`.
+    /// The compute path's: the outer smoothies' and the inner quads' indirect draws, one after
+    /// the other in `args`.
     Indirect {
         vertices: vk::DescriptorBufferInfo,
         args: vk::DescriptorBufferInfo,
@@ -857,13 +855,13 @@ enum Smoothies {
 
 impl Smoothies {
     /// The draws of the smoothie pass, one per [`Part`]; into the paper's buffer (`centred`
-    /// false) only the outer smoothies away from corners, the only part there is.
+    /// false) only the outer smoothies, the only part there is.
     fn draws(&self, centred: bool) -> Vec<(Part, Draw)> {
-        let parts = if centred { &Part::ALL[..] } else { &Part::ALL[..1] };
+        let parts = if centred { &[Part::Outer, Part::Inner][..] } else { &[Part::Outer] };
         let draw = |(i, &part): (usize, &Part)| match *self {
-            Smoothies::Direct { vertices, counts } => {
-                let first = counts[..i].iter().sum();
-                (counts[i] > 0).then_some((part, Draw::Vertices { vertices, first, count: counts[i] }))
+            Smoothies::Direct { vertices, outer, inner } => {
+                let (first, count) = if part == Part::Outer { (0, outer) } else { (outer, inner) };
+                (count > 0).then_some((part, Draw::Vertices { vertices, first, count }))
             }
             Smoothies::Indirect { vertices, args } => {
                 let offset = args.offset + i as u64 * DRAW_COMMAND_BYTES;
@@ -882,29 +880,18 @@ enum Draw {
     Indirect { vertices: vk::DescriptorBufferInfo, args: vk::DescriptorBufferInfo },
 }
 
-/// Which smoothies a draw of the smoothie pass holds: the outer smoothies or the inner quads
-/// (`INNER`, glsl/smoothie/centred.glsl), near the hard shadow's corners or not (`CORNERS`).
-/// Centred, each is drawn apart, running only its own part of the shader, since llvmpipe runs
-/// both branches of a test it cannot fold. Outer and inner drawn together, every fragment ran
-/// both; the images are the same bit for bit (the suite, both paths), and apart the smoothie
-/// pass took 0.85× its time on two_boxes (6.83 → 5.79 ms) and the wingnut, 0.90× on the
-/// sphere, 0.92× on the torus, and 1.03× on `default`, whose five casters' two draws cost more
-/// than their fragments save (512², lavapipe, medians of three interleaved runs of 20 frames;
-/// the compute path alike: two_boxes 7.0 → 5.9 ms).
+/// Which smoothies a draw of the smoothie pass holds (`INNER`, glsl/smoothie/centred.glsl).
+/// Centred, the outer smoothies and the inner quads are drawn apart, each running only its own
+/// part of the shader: drawn together, every fragment ran both, since llvmpipe runs both
+/// branches of a test it cannot fold. The images are the same bit for bit (the suite, both
+/// paths); the smoothie pass took 0.85× its time on two_boxes (6.83 → 5.79 ms) and the
+/// wingnut, 0.90× on the sphere, 0.92× on the torus, and 1.03× on `default`, whose five
+/// casters' two draws cost more than their fragments save (512², lavapipe, medians of three
+/// interleaved runs of 20 frames; the compute path alike: two_boxes 7.0 → 5.9 ms).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Part {
-    inner: bool,
-    corners: bool,
-}
-
-impl Part {
-    /// Every part, in drawing order.
-    const ALL: [Part; 4] = [
-        Part { inner: false, corners: false },
-        Part { inner: false, corners: true },
-        Part { inner: true, corners: false },
-        Part { inner: true, corners: true },
-    ];
+enum Part {
+    Outer,
+    Inner,
 }
 
 #[cfg(test)]
