@@ -54,8 +54,8 @@
 //! with: plate 0.0273 → 0.0068, contact 0.0261 → 0.0070, open_mesh 0.0323 → 0.0088, sphere
 //! 0.0163 → 0.0138, default 0.1415 → 0.1402; the sheets' pass on plate 0.16 → 0.40 ms, on the
 //! sphere 0.31 → 0.88 ms, on default 2.2 → 4.3–4.8 ms (interleaved runs), before the corners'
-//! inverse curve became a polynomial (`disk_below_inverse`), which took 0.3–0.4 ms of it back
-//! on contact and default.
+//! inverse curve became a polynomial (`disk_below_inverse`): the sheets' pass on contact then
+//! 3.29–3.34 → 2.85–3.13 ms, on default 3.88–4.42 → 3.77–3.85 (interleaved runs).
 //!
 //! Cost (issue 18). A cone is drawn only where no sheet covers it, the wedge of a corner
 //! (`cones = 0`: Haines' whole cones, measured against): on fine meshes, whose edges are far
