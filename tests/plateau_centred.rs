@@ -7,8 +7,9 @@
 mod common;
 
 use common::{
-    HIDDEN_IN_THE_SPHERE, as_accurate_on_fewer_texels, engine, error_minimising_scale, finish, largest_difference,
-    penumbra_pixels, reference, render_with, scene, sphere_with, suite_scene, terminator_error, top_down,
+    HIDDEN_IN_THE_SPHERE, as_accurate_on_fewer_texels, engine, error_minimising_scale, finish, l_shaped_slab,
+    largest_difference, penumbra_pixels, plate_corner, reference, render_with, scene, sees_at_the_corner, sphere_with,
+    suite_scene, terminator_error, top_down,
 };
 use softshadow::Capture;
 use softshadow::measure::{GROSS_ERROR, Metrics};
@@ -71,71 +72,19 @@ fn a_straight_plate_edge_penumbra_straddles_the_hard_edge() {
     assert!(widths(&outer).0 <= 1.0, "outer only: {:?}", widths(&outer));
 }
 
-/// A plate's corner (half size 1, 1 m up, the light 6 m up, radius 0.5): its hard shadow's
-/// corner at (1.2, 0) sees the light cut by both edges' lines, ¾ of it, where either sheet alone
-/// says ½, and around it the sides follow the reference within 0.06 (the footprint is 0.2 m
-/// across, 0.8 m seen: 32 px of 128).
+/// A plate's corner (common::plate_corner): its hard shadow's corner sees the light cut by both
+/// edges' lines, ¾ of it, where either sheet alone says ½, and around it the sides follow the
+/// reference within 0.06.
 #[test]
 fn a_plate_corner_sees_three_quarters_of_the_light() {
-    let object = "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 2.0]\nposition = [0.0, 1.0, -1.0]\n";
-    let s = top_down(1.2, 0.4, [0.0, 6.0, 0.0], 0.5, object);
-    sees_at_the_corner(&s, 0.70..=0.80);
+    sees_at_the_corner(&plate_corner(), "plateau", &[], (0.03, 0.06));
 }
 
-/// The plateau at `s`'s hard shadow corner, in the middle of a 128² image (between pixels 63
-/// and 64 both ways), within 0.03 of the reference, the reference's V in `truth`, and every
-/// pixel within 0.06 of the reference.
-fn sees_at_the_corner(s: &Scene, truth: std::ops::RangeInclusive<f32>) {
-    let (v, reference) = plateau_and_reference(s, 128);
-    let around = |c: &Capture| {
-        [(63, 63), (64, 63), (63, 64), (64, 64)].map(|(x, y)| c.visibility_at(x, y)).iter().sum::<f32>() / 4.0
-    };
-    let (corner, truth_corner) = (around(&v), around(&reference));
-    assert!(truth.contains(&truth_corner), "the reference's V at the corner {truth_corner}");
-    assert!((corner - truth_corner).abs() <= 0.03, "V at the corner {corner}, the reference's {truth_corner}");
-    let worst = largest_difference(&v, &reference);
-    assert!(worst <= 0.06, "V up to {worst} off the reference");
-}
-
-/// An L-shaped slab (two 2 × 1 m arms, 2 cm thick), 1 m up: its outline's one reflex vertex at
-/// the origin, the light 6 m up at (−2.5, −2.5) (radius 0.5), so that its hard shadow's reflex
-/// corner falls at (0.5, 0.5), in the quadrant the slab leaves open, seen from above 0.4 m each
-/// way. The corner sees about a quarter of the light (a right angle seen a little obliquely),
+/// An L-shaped slab's reflex corner (common::l_shaped_slab) sees about a quarter of the light,
 /// where either sheet alone says ½, and around it the sides follow the reference within 0.06.
 #[test]
 fn an_l_shaped_slab_s_reflex_corner_sees_a_quarter_of_the_light() {
-    use glam::Vec3;
-    // The outline anticlockwise in (x, z), the reflex vertex (1, 1) moved to the origin; each
-    // triangle wound so that its normal points along `out` (Mesh::new welds equal positions).
-    let outline =
-        [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)].map(|(x, z)| (x - 1.0, z - 1.0));
-    let vertex = |(x, z): (f32, f32), y: f32| Vec3::new(x, y, z);
-    let mut positions = Vec::new();
-    let mut face = |p: [Vec3; 3], out: Vec3| {
-        let flip = (p[1] - p[0]).cross(p[2] - p[0]).dot(out) < 0.0;
-        positions.extend(if flip { [p[0], p[2], p[1]] } else { p });
-    };
-    for k in 1..outline.len() - 1 {
-        let [a, b, c] = [outline[0], outline[k], outline[k + 1]];
-        face([a, b, c].map(|q| vertex(q, 0.01)), Vec3::Y);
-        face([a, b, c].map(|q| vertex(q, -0.01)), -Vec3::Y);
-    }
-    for k in 0..outline.len() {
-        let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
-        let out = Vec3::new(b.1 - a.1, 0.0, a.0 - b.0);
-        face([vertex(a, 0.01), vertex(b, 0.01), vertex(b, -0.01)], out);
-        face([vertex(a, 0.01), vertex(b, -0.01), vertex(a, -0.01)], out);
-    }
-    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
-    let slab = softshadow::scene::Mesh::new("L-shaped slab", positions, triangles).expect("a closed slab");
-    // A box placed where the slab goes, its mesh then swapped for the slab's.
-    let mut s = scene(
-        "[camera]\nposition = [0.5, 12.0, 0.5]\ntarget = [0.5, 0.0, 0.5]\nup = [0.0, 0.0, -1.0]\n\
-         ortho_half_height = 0.4\n[light]\nposition = [-2.5, 6.0, -2.5]\nradius = 0.5\n[ground]\nheight = 0.0\n\
-         [[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nposition = [0.0, 1.0, 0.0]\n",
-    );
-    s.objects[0].mesh = std::sync::Arc::new(slab);
-    sees_at_the_corner(&s, 0.15..=0.35);
+    sees_at_the_corner(&l_shaped_slab(), "plateau", &[], (0.03, 0.06));
 }
 
 /// A plate of half size 0.5 m, 2 m up, under a light 8 m up: from under its centre the plate

@@ -8,8 +8,9 @@
 mod common;
 
 use common::{
-    HIDDEN_IN_THE_SPHERE, as_accurate_on_fewer_texels, crossing, engine, error_minimising_scale, finish,
-    largest_difference, penumbra_pixels, reference, render_with, sphere_with, suite_scene, terminator_error,
+    HIDDEN_IN_THE_SPHERE, as_accurate_on_fewer_texels, crossing, engine, error_minimising_scale, finish, l_shaped_slab,
+    largest_difference, penumbra_pixels, plate_corner, reference, render_with, sees_at_the_corner, sphere_with,
+    suite_scene, terminator_error,
 };
 use softshadow::Capture;
 use softshadow::measure::{GROSS_ERROR, Metrics};
@@ -32,6 +33,17 @@ fn strip(height: f32, radius: f32, (centre, half): (f32, f32)) -> Scene {
         "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 6.0]\nposition = [0.0, {height}, 0.0]\nreceives = false\n"
     );
     common::top_down(centre, half, [-3.0, 10.0, 0.0], radius, &plate)
+}
+
+/// A plate's convex corner and an L-shaped slab's reflex one (common::plate_corner,
+/// common::l_shaped_slab): the smoothies near them take V from both edges' lines, ¾ and about ¼,
+/// where each edge's smoothie alone said ½; on both silhouette paths.
+#[test]
+fn the_hard_shadow_s_corners_see_what_both_edges_leave_of_the_light() {
+    for sets in [&[][..], &[("gpu_silhouettes", "1")]] {
+        sees_at_the_corner(&plate_corner(), "smoothie", sets, (0.03, 0.06));
+        sees_at_the_corner(&l_shaped_slab(), "smoothie", sets, (0.03, 0.06));
+    }
 }
 
 /// V along the middle row, with each pixel's world x.

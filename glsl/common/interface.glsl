@@ -68,7 +68,9 @@ struct SilhouetteParams {
                       // z: centred, the light's radius (partial silhouettes), else 0; w: PARTIAL_GAIN
     vec4 ground;      // xyz: the ground's inverse light depth along the ray (x, y, 1); w: 1 where it
                       // bounds the receivers (src/geometry/smoothie.rs's ReceiverBound), else 0
-    vec4 pad[8];
+    vec4 corners;     // the hard shadow's corners (src/geometry/smoothie.rs's ShadowCorner): x MIN_TURN,
+                      // y CORNER_REACH, z SHARPEST_TURN, w CORNER_PIECE
+    vec4 pad[7];
 };
 
 // One caster's shadow volume from one light point, built on the GPU (shadow-volume,

@@ -14,6 +14,12 @@ layout(location = 1) in vec2 in_shape; // perspective-correct: distance over siz
 layout(location = 2) noperspective in vec2 in_probe;
 layout(location = 3) flat in vec2 in_range;
 layout(location = 4) flat in float in_channel;
+layout(location = 5) flat in vec2 in_corner;
+layout(location = 6) flat in vec4 in_normals;
+layout(location = 7) flat in float in_turn;
+layout(location = 8) noperspective in float in_size;
+layout(location = 9) noperspective in float in_along;
+layout(location = 10) flat in vec2 in_keep;
 
 float map_at(vec2 uv) {
     float size = light.bias.w;

@@ -8,7 +8,8 @@
 // Target 0: the outer smoothies' nearest depth b (its code, depth.glsl; where only inner quads
 // with α < 1 lie, centred.glsl's INNER_MARK) and the even casters' remapped alpha α' (Equation
 // 1). Target 1: the inner quads' 1 − code(b), the farthest inner depth, and their alpha α.
-// Target 2: the odd casters' α' and the inner quads' limit (centred.glsl), the nearest. Two
+// Target 2: the odd casters' α' and the inner quads' limit (centred.glsl), the nearest. Alphas
+// as centred.glsl's alpha_code stores them. Two
 // channels each: llvmpipe clears a four-channel 16-bit target at about a third of the bytes per
 // second of a two-channel one (plate, 1024², the clear alone: 3.2 ms for one RGBA target, 1.3
 // ms for two RG targets of the same bytes).
@@ -35,10 +36,10 @@ layout(location = 0) out vec2 out_outer;
 layout(location = 1) out vec2 out_inner;
 layout(location = 2) out vec2 out_odd;
 
-// α with the channel in its lowest bit, as a 16-bit unsigned normalized value (32-bit floats
-// hold the same code exactly); resolve.frag's texels() reads it back.
+// α's code (alpha_code) with the channel in its lowest bit, as a 16-bit unsigned normalized
+// value (32-bit floats hold the same code exactly); resolve.frag's texels() reads it back.
 float with_channel(float alpha, float channel) {
-    return (2.0 * round(alpha * 32767.0) + channel) / 65535.0;
+    return (2.0 * round(alpha_code(alpha) * 32767.0) + channel) / 65535.0;
 }
 
 void main() {
@@ -53,7 +54,7 @@ void main() {
         return;
     }
     bool even = in_channel == 0.0;
-    out_outer = vec2(c.code, even ? c.alpha : 1.0);
+    out_outer = vec2(c.code, even ? alpha_code(c.alpha) : 1.0);
     out_inner = vec2(1.0);
-    out_odd = vec2(even ? 1.0 : c.alpha, 1.0);
+    out_odd = vec2(even ? 1.0 : alpha_code(c.alpha), 1.0);
 }

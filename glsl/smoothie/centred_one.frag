@@ -4,8 +4,9 @@
 // where only inner quads with α < 1 lie, centred.glsl's INNER_MARK) and remapped alpha α'
 // (Equation 1); target 1: the inner quads' 1 − code(b) (the farthest inner depth) and alpha α
 // (the shallowest, the lightest: see centred.frag), as centred.frag's first two, less the
-// channel bit. With no other caster there are no channels to keep apart and no limits (one
-// caster has no other beside it): centred.frag's third target is not needed.
+// channel bit; alphas as centred.glsl's alpha_code stores them. With no other caster there are
+// no channels to keep apart and no limits (one caster has no other beside it): centred.frag's
+// third target is not needed.
 #include "centred.glsl"
 
 layout(location = 0) out vec2 out_outer;
@@ -16,6 +17,6 @@ void main() {
     if (!centred_fragment(c)) {
         discard;
     }
-    out_outer = c.inner ? vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0) : vec2(c.code, c.alpha);
-    out_inner = c.inner ? vec2(1.0 - c.code, c.alpha) : vec2(1.0);
+    out_outer = c.inner ? vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0) : vec2(c.code, alpha_code(c.alpha));
+    out_inner = c.inner ? vec2(1.0 - c.code, alpha_code(c.alpha)) : vec2(1.0);
 }

@@ -92,6 +92,12 @@ Texels texels(vec2 uv, float depth) {
         // Beyond its limit (centred.glsl) the receiver may not see past the edge: umbra.
         t.inner = mix(vec4(coded >> 1u) / 32767.0, vec4(1.0), greaterThan(vec4(code), limit + LIMIT_SLACK));
     }
+    if (CENTRED) {
+        // Signed alphas from their codes (centred.glsl's alpha_code); 1 stays 1.
+        t.outer = 2.0 * t.outer - 1.0;
+        t.outer_odd = 2.0 * t.outer_odd - 1.0;
+        t.inner = 2.0 * t.inner - 1.0;
+    }
     t.behind = vec4(greaterThan(vec4(code), t.b));
     // Its own silhouette's outer smoothie reaches a receiver only across the bilinear texel,
     // and there at contact (b/r → 1, as at a terminator): within the limits' slack.
@@ -148,8 +154,9 @@ vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map, float self_l
     if (t.behind == vec4(0.0) && t.inner == vec4(1.0)) {
         return vec2(umbra, 1.0);
     }
-    // Equation 1 for the inner half, r the receiver's depth (contact, b ≥ r: hard).
-    vec4 a = clamp(t.inner / max(1.0 - min(code_depth(light, t.inner_b) / depth, vec4(1.0)), 1e-6), 0.0, 1.0);
+    // Equation 1 for the inner half, r the receiver's depth (contact, b ≥ r: hard); below 0
+    // near a convex corner, lighter than the hard edge.
+    vec4 a = clamp(t.inner / max(1.0 - min(code_depth(light, t.inner_b) / depth, vec4(1.0)), 1e-6), -1.0, 1.0);
     // The map at each smoothie texel's centre: is the receiver behind a caster there?
     vec4 caster = map.d;
     float map_size = light.bias.w;

@@ -1,7 +1,7 @@
 #version 460
 // Beyond the paper (which found silhouettes on the host, §4): silhouette detection and
 // smoothie generation on the GPU, one invocation per edge, appended into a vertex buffer whose
-// counts feed two indirect draws. Same construction as src/geometry/smoothie.rs.
+// counts feed four indirect draws. Same construction as src/geometry/smoothie.rs.
 #include "interface.glsl"
 
 layout(local_size_x = 64) in;
@@ -17,15 +17,24 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
-// Two indirect draws: the outer smoothies', then the inner quads', each kind appended to its own
-// half of the vertex buffer, so that the smoothie pass draws each with its own shader
-// (smoothie.rs's `Part`).
+// Four indirect draws, one per part of the smoothie pass (smoothie.rs's `Part`): the outer
+// smoothies away from the hard shadow's corners and near them, then the inner quads alike. Each
+// kind takes a half of the vertex buffer, those away from corners appended from its start, those
+// near them from its end back, so that the smoothie pass draws each part with its own shader.
 struct Draw { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
-layout(std430, set = 0, binding = 5) buffer Args { Draw draws[2]; };
-// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel (src/geometry/smoothie.rs's
-// SmoothieVertex)
+layout(std430, set = 0, binding = 5) buffer Args { Draw draws[4]; };
+// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel, cx, cy, normals, turn, along, keep
+// (src/geometry/smoothie.rs's SmoothieVertex)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
-const uint FLOATS = 13u;
+const uint FLOATS = 23u;
+// What a smoothie that is no piece of a cut quad keeps (src/geometry/smoothie.rs's KEEP_ALL).
+const vec2 KEEP_ALL = vec2(-3.40282347e38, 3.40282347e38);
+// How far a piece of a cut quad reaches past its cuts, in smoothie widths (CUT_MARGIN there).
+const float CUT_MARGIN = 0.25;
+// How far a cut quad's sliver over its base reaches from it (SLIVER there).
+const float SLIVER = 0.125;
+// How much of each other's part two pieces keep at their cut (KEEP_SLACK there).
+const float KEEP_SLACK = 1e-4;
 
 vec3 view_position(uint v) {
     return (params.model_view * vec4(positions[v].xyz, 1.0)).xyz;
@@ -43,6 +52,11 @@ bool lit(uint face) {
 
 float smoothie_t(float depth) {
     return PHYSICAL_SIZE ? params.size.x / (depth + params.light.x) : params.size.x;
+}
+
+// The projective weight of a smoothie of size t (src/geometry/smoothie.rs's weighted).
+float weight(float t) {
+    return t > 0.0 && !isinf(t) ? 1.0 / t : 1.0;
 }
 
 // The farthest a receiver can lie behind the hull of q (src/geometry/smoothie.rs's
@@ -63,39 +77,140 @@ float reach(float depth, float far) {
     return clamp(1.0 - depth / far, 0.0, 1.0);
 }
 
-// Inner quads' extra data: each vertex's point on the edge, the edge's outward normal, the
-// caster's depth range; zero for the outer smoothies.
+// What a smoothie vertex interpolates: its point, depth, shape, foot (inner quads' point on
+// the edge), projective weight, and how far along its edge (pieces of a cut quad).
+struct Vertex {
+    vec2 p;
+    float b;
+    vec2 shape;
+    vec2 foot;
+    float w;
+    float along;
+};
+
+// Inner quads' extra data: the edge's outward normal (or a wedge's bisector) and the caster's
+// depth range; zero for the outer smoothies.
 struct Inner {
-    vec2 foot[4];
     vec2 normal;
     vec2 range;
 };
 
-void put(uint at, vec2 p, float b, vec2 shape, vec2 foot, vec2 normal, vec2 range, float w) {
-    float v[13] = float[13](p.x, p.y, b, shape.x, shape.y, foot.x, foot.y, normal.x, normal.y, range.x, range.y, w, params.light.y);
+const Inner OUTER = Inner(vec2(0.0), vec2(0.0));
+
+// The hard shadow's corner a smoothie carries (src/geometry/smoothie.rs's ShadowCorner): its
+// vertex, both edges' outward normals, and its turn, 1 convex, -1 reflex; 0: none.
+struct Corner {
+    vec2 at;
+    vec4 normals;
+    float turn;
+};
+
+const Corner NO_CORNER = Corner(vec2(0.0), vec4(0.0), 0.0);
+
+void put(uint at, Vertex v, Inner inner, Corner c, vec2 keep) {
+    float f[23] = float[23](v.p.x, v.p.y, v.b, v.shape.x, v.shape.y, v.foot.x, v.foot.y, inner.normal.x,
+                            inner.normal.y, inner.range.x, inner.range.y, v.w, params.light.y, c.at.x, c.at.y,
+                            c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn, v.along, keep.x, keep.y);
     for (uint k = 0u; k < FLOATS; k++) {
-        vertices[FLOATS * at + k] = v[k];
+        vertices[FLOATS * at + k] = f[k];
     }
 }
 
-// Six vertices, two triangles: the quad q0 q1 q2 q3, with projective weights w (1/t on edges,
-// as src/geometry/smoothie.rs's SmoothieVertex::w).
-void quad(vec2 q[4], float b[4], vec2 s[4], Inner inner, float w[4]) {
-    // An inner quad's range is its caster's depths, beyond 0; the outer smoothies' is 0 or −1.
+// Where `count` vertices of this kind go (an inner quad's range is its caster's depths, beyond
+// 0; the outer smoothies' is 0 or −1), near a corner or not; false where the kind's half of the
+// buffer is full (sized so that it never is).
+bool append(Inner inner, Corner c, uint count, out uint at) {
     uint kind = inner.range.y > 0.0 ? 1u : 0u;
-    uint at = atomicAdd(draws[kind].vertex_count, 6u);
-    if (at + 6u > params.counts.z) {
-        return; // sized so that it never happens; never write past the kind's half
+    if (c.turn == 0.0) {
+        at = atomicAdd(draws[2u * kind].vertex_count, count);
+        if (at + count > params.counts.z) {
+            return false;
+        }
+        at += kind * params.counts.z;
+        return true;
     }
-    at += kind * params.counts.z;
-    const int order[6] = int[6](0, 1, 2, 0, 2, 3);
-    for (int k = 0; k < 6; k++) {
-        int o = order[k];
-        put(at + uint(k), q[o], b[o], s[o], inner.foot[o], inner.normal, inner.range, w[o]);
+    atomicAdd(draws[2u * kind + 1u].vertex_count, count);
+    at = atomicAdd(draws[2u * kind + 1u].first_vertex, -count) - count;
+    return at >= kind * params.counts.z && at <= (kind + 1u) * params.counts.z; // from the half's end back
+}
+
+// Six vertices, two triangles: the quad q0 q1 q2 q3, keeping `keep` of its edge.
+void quad(Vertex q[4], Inner inner, Corner c, vec2 keep) {
+    uint at;
+    if (append(inner, c, 6u, at)) {
+        const int order[6] = int[6](0, 1, 2, 0, 2, 3);
+        for (int k = 0; k < 6; k++) {
+            put(at + uint(k), q[order[k]], inner, c, keep);
+        }
     }
 }
 
-const Inner OUTER = Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(0.0));
+// One triangle.
+void triangle(Vertex t[3], Inner inner, Corner c, vec2 keep) {
+    uint at;
+    if (append(inner, c, 3u, at)) {
+        for (int k = 0; k < 3; k++) {
+            put(at + uint(k), t[k], inner, c, keep);
+        }
+    }
+}
+
+// a + (b − a)·u, as src/geometry/smoothie.rs's between takes it.
+float lerp(float a, float b, float u) {
+    return a + (b - a) * u;
+}
+
+vec2 lerp(vec2 a, vec2 b, float u) {
+    return a + (b - a) * u;
+}
+
+// The vertex u of the way from a to b, two vertices of one quad's side, as the rasterizer
+// interpolates there (src/geometry/smoothie.rs's between).
+Vertex between(Vertex a, Vertex b, float u) {
+    float ta = 1.0 / a.w, tb = 1.0 / b.w, t = lerp(ta, tb, u);
+    return Vertex(lerp(a.p, b.p, u), lerp(a.b, b.b, u), lerp(a.shape * ta, b.shape * tb, u) / t, lerp(a.foot, b.foot, u),
+                  1.0 / t, lerp(a.along, b.along, u));
+}
+
+// Where an edge's outer and inner quads are cut for the corners at its ends, alike
+// (src/geometry/smoothie.rs's corner_cuts).
+vec2 corner_cuts(Vertex outer[4], Vertex inner[4], Corner corners[2]) {
+    float length = distance(outer[0].p, outer[1].p);
+    float wa = max(distance(outer[0].p, outer[3].p), distance(inner[0].p, inner[3].p));
+    float wb = max(distance(outer[1].p, outer[2].p), distance(inner[1].p, inner[2].p));
+    bool a = corners[0].turn != 0.0, b = corners[1].turn != 0.0;
+    float ua = a ? params.corners.w * wa / length : 0.0, ub = b ? params.corners.w * wb / length : 0.0;
+    if (ua + ub < 1.0) {
+        return vec2(ua, ub);
+    }
+    return a && b ? vec2(0.5) : vec2(a ? 1.0 : 0.0, b ? 1.0 : 0.0);
+}
+
+// An edge's quad q (its base from end a to end b, then its rim back) in pieces cut at `cuts`,
+// those within reach of a corner at either end carrying it, each reaching CUT_MARGIN past its
+// cuts and keeping its own part (src/geometry/smoothie.rs's edge_quad).
+void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
+    if (corners[0].turn == 0.0 && corners[1].turn == 0.0) {
+        quad(q, inner, NO_CORNER, KEEP_ALL);
+        return;
+    }
+    float width = max(distance(q[0].p, q[3].p), distance(q[1].p, q[2].p));
+    float margin = CUT_MARGIN * width / distance(q[0].p, q[1].p);
+    // With each piece, the sliver over the whole hard edge (SLIVER there).
+    Vertex sliver = between(between(q[0], q[1], 0.5), between(q[3], q[2], 0.5), SLIVER);
+    float u[4] = float[4](0.0, cuts.x, 1.0 - cuts.y, 1.0);
+    for (int j = 0; j < 3; j++) {
+        if (u[j] < u[j + 1]) {
+            vec2 keep = vec2(u[j] > 0.0 ? u[j] - KEEP_SLACK : KEEP_ALL.x, u[j + 1] < 1.0 ? u[j + 1] + KEEP_SLACK : KEEP_ALL.y);
+            float g0 = max(u[j] - margin, 0.0), g1 = min(u[j + 1] + margin, 1.0);
+            Vertex piece[4] = Vertex[4](between(q[0], q[1], g0), between(q[0], q[1], g1), between(q[3], q[2], g1),
+                                        between(q[3], q[2], g0));
+            Corner c = j == 0 ? corners[0] : (j == 2 ? corners[1] : NO_CORNER);
+            quad(piece, inner, c, keep);
+            triangle(Vertex[3](q[0], q[1], sliver), inner, c, keep);
+        }
+    }
+}
 
 // Two dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex: PAIRING
 // counts each silhouette vertex's edge ends (stamped, so no clear is needed) and keeps the first
@@ -151,49 +266,97 @@ uint arrive(uint v) {
     }
 }
 
-void corner_quad(vec2 p, float z, float t, vec2 o[4], Inner inner) {
-    vec2 q[4] = vec2[4](p + o[0] * t, p + o[1] * t, p + o[2] * t, p + o[3] * t);
-    quad(q, float[4](z, z, z, z), o, inner, float[4](1.0, 1.0, 1.0, 1.0));
+// A corner's quad: the offsets o (shape units) from p, scaled by its size t.
+void corner_quad(vec2 p, float z, float t, vec2 o[4], Inner inner, Corner c) {
+    Vertex q[4];
+    for (int k = 0; k < 4; k++) {
+        q[k] = Vertex(p + o[k] * t, z, o[k], inner.range.y > 0.0 ? p : vec2(0.0), weight(t), 0.0);
+    }
+    quad(q, inner, c, KEEP_ALL);
 }
 
 // The sector from n0 to n1 about their bisector m, radius kk: two kites, as
 // src/geometry/smoothie.rs's wedge.
-void wedge(vec2 p, float z, float t, vec2 n0, vec2 n1, vec2 m, float kk, Inner inner) {
+void wedge(vec2 p, float z, float t, vec2 n0, vec2 n1, vec2 m, float kk, Inner inner, Corner c) {
     vec2 ns[2] = vec2[2](n0, n1);
     for (int j = 0; j < 2; j++) {
         vec2 tip = (ns[j] + m) / (1.0 + dot(ns[j], m));
-        corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk), inner);
+        corner_quad(p, z, t, vec2[4](vec2(0.0), ns[j] * kk, tip * kk, m * kk), inner, c);
     }
 }
 
-// The corner at end k of silhouette s, given the vertex's end count and its other end.
-void corner(Silhouette s, int k, uint count, uint other) {
-    vec2 p = s.t[k];
-    float z = s.z[k], t = smoothie_t(z);
-    // The square of half-size t holds every kind of corner.
-    float kk = reach(z, far_over(vec2[4](p + t, p + vec2(t, -t), p - t, p + vec2(-t, t))));
+// A corner's size t at p (depth z) and its reach kk over the square of half-size t about it
+// (src/geometry/smoothie.rs's corner_size).
+void corner_size(vec2 p, float z, out float t, out float kk) {
+    t = smoothie_t(z);
+    kk = reach(z, far_over(vec2[4](p + t, p + vec2(t, -t), p - t, p + vec2(-t, t))));
+}
+
+// How the outline turns at end k of silhouette s, where the pairing found `count` ends at its
+// vertex and `other` beside it (src/geometry/smoothie.rs's Turn): false unless exactly two
+// sided ends meet with their normals on the same side of the path.
+bool turn_at(Silhouette s, int k, uint count, uint other, out vec2 n1, out vec2 n2, out vec2 m, out float bend,
+             out float other_length) {
     Silhouette o;
-    if (count == 2u && s.sided && silhouette(other >> 1u, o) && o.sided) {
-        vec2 d1 = k == 0 ? s.along : -s.along, n1 = s.normal;
-        vec2 d2 = (other & 1u) == 0u ? o.along : -o.along, n2 = o.normal;
-        // As src/geometry/smoothie.rs: normals on opposite sides of the path get the square;
-        // a convex turn the outer wedge, a concave one (centred) the inner wedge.
-        vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
-        bool consistent = dot(p1, n1) * dot(p2, n2) > 0.0;
-        vec2 m = n1 + n2;
-        if (consistent && dot(m, m) > 0.0) {
-            m = normalize(m);
-            float turn = dot(n1, d2);
-            if (turn < 0.0) {
-                wedge(p, z, t, n1, n2, m, kk, OUTER);
-            } else if (turn > 0.0 && params.counts.w != 0u) {
-                Inner inner = Inner(vec2[4](p, p, p, p), m, params.size.yw);
-                wedge(p, z, t, -n1, -n2, -m, kk, inner);
-            }
-            return;
-        }
+    if (count != 2u || !s.sided || !silhouette(other >> 1u, o) || !o.sided) {
+        return false;
     }
-    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER);
+    vec2 d1 = k == 0 ? s.along : -s.along, d2 = (other & 1u) == 0u ? o.along : -o.along;
+    n1 = s.normal;
+    n2 = o.normal;
+    vec2 p1 = vec2(d1.y, -d1.x), p2 = vec2(-d2.y, d2.x);
+    m = n1 + n2;
+    if (dot(p1, n1) * dot(p2, n2) <= 0.0 || dot(m, m) == 0.0) {
+        return false;
+    }
+    m = normalize(m);
+    bend = dot(n1, d2);
+    other_length = distance(o.t[0], o.t[1]);
+    return true;
+}
+
+// The vertex's other end beside end k of edge i.
+uint other_end(uint i, int k, uint v) {
+    uint first = stamps[3u * v + 1u];
+    return first == 2u * i + uint(k) ? stamps[3u * v + 2u] : first;
+}
+
+// Centred, the hard shadow's corner at end k of edge i, silhouette s (src/geometry/smoothie.rs's
+// shadow_corner).
+Corner shadow_corner(Silhouette s, uint i, int k) {
+    uint v = s.v[k];
+    vec2 n1, n2, m;
+    float bend, other_length;
+    if (params.counts.w == 0u || !turn_at(s, k, stamps[3u * v] & 3u, other_end(i, k, v), n1, n2, m, bend, other_length)) {
+        return NO_CORNER;
+    }
+    float t, kk;
+    corner_size(s.t[k], s.z[k], t, kk);
+    float radius = params.corners.y * t * kk;
+    bool long_enough = distance(s.t[0], s.t[1]) >= radius && other_length >= radius;
+    bool turns = abs(n1.x * n2.y - n1.y * n2.x) > params.corners.x && dot(n1, n2) >= params.corners.z && bend != 0.0;
+    return long_enough && turns ? Corner(s.t[k], vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
+}
+
+// The corner at end k of silhouette s (edge i), given the vertex's end count and its other end.
+void corner(Silhouette s, uint i, int k, uint count, uint other) {
+    vec2 p = s.t[k];
+    float z = s.z[k], t, kk;
+    corner_size(p, z, t, kk);
+    vec2 n1, n2, m;
+    float bend, other_length;
+    if (turn_at(s, k, count, other, n1, n2, m, bend, other_length)) {
+        // As src/geometry/smoothie.rs: a convex turn the outer wedge, a concave one (centred)
+        // the inner wedge.
+        Corner c = shadow_corner(s, i, k);
+        if (bend < 0.0) {
+            wedge(p, z, t, n1, n2, m, kk, OUTER, c);
+        } else if (bend > 0.0 && params.counts.w != 0u) {
+            wedge(p, z, t, -n1, -n2, -m, kk, Inner(m, params.size.yw), c);
+        }
+        return;
+    }
+    corner_quad(p, z, t, vec2[4](vec2(-kk, -kk), vec2(kk, -kk), vec2(kk, kk), vec2(-kk, kk)), OUTER, NO_CORNER);
 }
 
 // The reach's receivers behind the uncut quad from edge ta–tb out by ta's and tb's t.
@@ -203,15 +366,16 @@ float far_quad(vec2 ta, vec2 tb, float sa, float sb, vec2 out_dir) {
 
 // The smoothie edge of the hard edge ta–tb (depths za, zb) out along `out_dir`, alpha 0 on the
 // edge and the reach k at t·k out, with projective weights 1/t (src/geometry/smoothie.rs's
-// SmoothieVertex::w).
-void edge_quad(vec2 ta, vec2 tb, float za, float zb, vec2 out_dir, Inner inner) {
+// SmoothieVertex::w); an inner quad's feet on the edge.
+void edge_quad(vec2 ta, vec2 tb, float za, float zb, vec2 out_dir, bool feet, out Vertex q[4]) {
     float sa = smoothie_t(za), sb = smoothie_t(zb);
     float far = far_quad(ta, tb, sa, sb, out_dir);
     float ka = reach(za, far), kb = reach(zb, far);
     vec2 da = out_dir * sa * ka, db = out_dir * sb * kb;
-    float wa = sa > 0.0 && !isinf(sa) ? 1.0 / sa : 1.0, wb = sb > 0.0 && !isinf(sb) ? 1.0 / sb : 1.0;
-    quad(vec2[4](ta, tb, tb + db, ta + da), float[4](za, zb, zb, za),
-         vec2[4](vec2(0.0), vec2(0.0), vec2(kb, 0.0), vec2(ka, 0.0)), inner, float[4](wa, wb, wb, wa));
+    float wa = weight(sa), wb = weight(sb);
+    vec2 fa = feet ? ta : vec2(0.0), fb = feet ? tb : vec2(0.0);
+    q = Vertex[4](Vertex(ta, za, vec2(0.0), fa, wa, 0.0), Vertex(tb, zb, vec2(0.0), fb, wb, 1.0),
+                  Vertex(tb + db, zb, vec2(kb, 0.0), fb, wb, 1.0), Vertex(ta + da, za, vec2(ka, 0.0), fa, wa, 0.0));
 }
 
 uint third_of(uvec4 t, uvec2 e) {
@@ -283,7 +447,9 @@ void partial_silhouette(uint i) {
             continue;
         }
         float behind = max(max(pa.z, pb.z), pc.z);
-        edge_quad(ta, tb, pa.z, pb.z, normal, Inner(vec2[4](vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0)), vec2(0.0), vec2(behind, -1.0)));
+        Vertex q[4];
+        edge_quad(ta, tb, pa.z, pb.z, normal, false, q);
+        quad(q, Inner(vec2(0.0), vec2(behind, -1.0)), NO_CORNER, KEEP_ALL);
     }
 }
 
@@ -311,16 +477,24 @@ void main() {
     for (int k = 0; k < 2; k++) {
         uint v = s.v[k];
         if (stamps[3u * v + 1u] == 2u * i + uint(k)) {
-            corner(s, k, stamps[3u * v] & 3u, stamps[3u * v + 2u]);
+            corner(s, i, k, stamps[3u * v] & 3u, stamps[3u * v + 2u]);
         }
     }
     if (!s.sided) {
         return;
     }
-    vec2 ta = s.t[0], tb = s.t[1];
-    edge_quad(ta, tb, s.z[0], s.z[1], s.normal, OUTER);
-    if (params.counts.w != 0u) {
-        // The inner quad, mirrored over the blocker (issue 20).
-        edge_quad(ta, tb, s.z[0], s.z[1], -s.normal, Inner(vec2[4](ta, tb, tb, ta), s.normal, params.size.yw));
+    Vertex outer[4];
+    edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], s.normal, false, outer);
+    if (params.counts.w == 0u) {
+        quad(outer, OUTER, NO_CORNER, KEEP_ALL);
+        return;
     }
+    // Centred, the inner quad too, mirrored over the blocker (issue 20), both in pieces near
+    // the hard shadow's corners.
+    Vertex inner[4];
+    edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], -s.normal, true, inner);
+    Corner corners[2] = Corner[2](shadow_corner(s, i, 0), shadow_corner(s, i, 1));
+    vec2 cuts = corner_cuts(outer, inner, corners);
+    edge_pieces(outer, OUTER, corners, cuts);
+    edge_pieces(inner, Inner(s.normal, params.size.yw), corners, cuts);
 }

@@ -12,6 +12,14 @@ layout(location = 3) in vec2 in_normal;        // inner quads: the edge's outwar
 layout(location = 4) in vec2 in_range;         // inner quads: the caster's depth range; 0: outer
 layout(location = 5) in float in_w;            // projective weight 1/t: edges' alpha exact (SmoothieVertex::w)
 layout(location = 6) in float in_channel;      // centred: the caster's channel, 0 or 1
+// Centred, near a corner of the hard shadow (SmoothieVertex::turn): its vertex, both edges'
+// outward normals, and its turn (1 convex, −1 reflex; 0 none).
+layout(location = 7) in vec2 in_corner;
+layout(location = 8) in vec4 in_normals;
+layout(location = 9) in float in_turn;
+// Pieces of a cut quad (SmoothieVertex::along): how far along the edge, and the part they keep.
+layout(location = 10) in float in_along;
+layout(location = 11) in vec2 in_keep;
 
 // Linear in the buffer but the alpha (`shape`), which w makes distance over size.
 layout(location = 0) noperspective out float out_b;
@@ -19,6 +27,13 @@ layout(location = 1) out vec2 out_shape;
 layout(location = 2) noperspective out vec2 out_probe;
 layout(location = 3) flat out vec2 out_range;
 layout(location = 4) flat out float out_channel;
+layout(location = 5) flat out vec2 out_corner;
+layout(location = 6) flat out vec4 out_normals;
+layout(location = 7) flat out float out_turn;
+// The smoothie size t, affine across a quad as its alpha's distance is (SmoothieVertex::w).
+layout(location = 8) noperspective out float out_size;
+layout(location = 9) noperspective out float out_along;
+layout(location = 10) flat out vec2 out_keep;
 
 vec2 to_uv(vec2 tangent) {
     return (tangent - light.extent.xy) / (light.extent.zw - light.extent.xy);
@@ -34,5 +49,11 @@ void main() {
     out_probe = to_uv(in_foot + in_normal * 1.5 * max(texel.x, texel.y));
     out_range = in_range;
     out_channel = in_channel;
+    out_corner = in_corner;
+    out_normals = in_normals;
+    out_turn = in_turn;
+    out_size = 1.0 / in_w;
+    out_along = in_along;
+    out_keep = in_keep;
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0) * in_w;
 }

@@ -87,7 +87,10 @@ pub struct SilhouetteParams {
     /// xyz: the ground's inverse light depth along the ray (x, y, 1), w: 1 where it bounds the
     /// receivers (`geometry::smoothie::ReceiverBound`), else 0.
     pub ground: Vec4,
-    pub pad: [Vec4; 8],
+    /// The hard shadow's corners (`geometry::smoothie::ShadowCorner`): x `MIN_TURN`, y its
+    /// `CORNER_REACH`, z `SHARPEST_TURN`, w `CORNER_PIECE`.
+    pub corners: Vec4,
+    pub pad: [Vec4; 7],
 }
 
 /// One caster's shadow volume from one light point, built on the GPU, padded to 256 bytes

@@ -787,11 +787,12 @@ const PARALLEL_CHUNK: usize = 256;
 /// hard shadow there is t = 0 whatever the sides hold).
 type Covers = [Option<(Vec2, Vec2)>; 2];
 
-/// How far (the sine of the angle) two edges must turn at a vertex for it to be a [`Corner`].
+/// How far (the sine of the angle) two edges must turn at a vertex for it to be a [`Corner`]
+/// (or a smoothie's [`ShadowCorner`](super::smoothie::ShadowCorner)).
 /// A finely tessellated curve turns less at each vertex, where the footprint cut by both lines
 /// differs from the sheets' by at most about the turn over 2π, 0.003 (an estimate, not
 /// measured).
-const MIN_TURN: f32 = 0.02;
+pub const MIN_TURN: f32 = 0.02;
 
 /// How many footprint radii (the cone's semi-major axis) each of a [`Corner`]'s edges must run
 /// from it: a line that runs on past its edge's end, a radius or more, cuts the footprint where

@@ -25,11 +25,21 @@
 //! the outer wedge fills (see [`corner`]).
 //! [`partial_smoothies`] adds the smoothie edges of edges that are the silhouette for part of
 //! the light only.
+//!
+//! Centred, near a corner of the hard shadow ([`ShadowCorner`]) the truth cuts the light's
+//! footprint by both edges' lines, where each smoothie takes its own: at a convex corner the
+//! apex sees ¾ of the light and the smoothies said ½ (plate: errors up to 0.25 at its four
+//! corners), at a reflex one ¼. As the plateau's sides do (`geometry::plateau`'s `Corner`), the
+//! smoothies near such a corner carry it, its vertex and both edges' normals, and the smoothie
+//! pass writes the alpha that gives V under both lines (`glsl/smoothie/centred.glsl`). Only the
+//! pieces of an edge's quads within reach of the corner carry it ([`CORNER_PIECE`]), so that
+//! only their fragments pay for its arithmetic.
 
 use glam::{Mat4, Vec2, Vec3};
 
 use super::Aabb;
 use super::chains::{self, MergedEdge, PenumbraEdge};
+use super::plateau::MIN_TURN;
 use super::silhouette::{Caster, EdgeSource, FacePlanes, PARTIAL_GAIN, PartialEdge, penumbra_edges};
 
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
@@ -62,12 +72,64 @@ pub struct SmoothieVertex {
     /// not linear across its quad, and interpolated linearly it would depend on which diagonal
     /// splits the quad (up to 8/255 in V on the plate). Drawn with w = 1/t, the perspective-
     /// correct interpolation of α gives Σλd / Σλt, exact for the quad's affine d and t.
-    /// Corners have one t: any constant does.
+    /// Corners have one t, where any constant would do: theirs too, so that 1/w is the size t
+    /// on every smoothie (the corners' arithmetic, `glsl/smoothie/centred.glsl`).
     pub w: f32,
     /// Which of the centred buffer's two channels the caster's smoothies go to (0 or 1, by
     /// the parity of its number; see [`SmoothieGeometry::in_channel`]).
     pub channel: f32,
+    /// Centred, near a corner of the hard shadow ([`ShadowCorner`]): its vertex, tangent
+    /// coordinates; zero elsewhere.
+    pub cx: f32,
+    pub cy: f32,
+    /// Its two edges' outward normals.
+    pub normals: [f32; 4],
+    /// 1 where the hard shadow is convex there, −1 reflex; 0: no corner.
+    pub turn: f32,
+    /// Pieces of an edge's quads ([`edge_quad`]): how far along the edge, 0 at its first end, 1
+    /// at its second; and the part of that the piece draws, its fragments elsewhere discarded.
+    /// [`KEEP_ALL`] elsewhere.
+    pub along: f32,
+    pub keep: [f32; 2],
 }
+
+/// What a smoothie that is no piece of a cut quad keeps: everything.
+pub const KEEP_ALL: [f32; 2] = [f32::MIN, f32::MAX];
+
+/// A vertex of the hard shadow's outline where two silhouette edges turn (issue 20): near it
+/// the penumbra is the light's footprint cut by both edges' lines. As the plateau's `Corner`
+/// (`geometry::plateau`): a turn of [`MIN_TURN`] at least; and each edge [`CORNER_REACH`]
+/// footprint radii long or more, so that both lines stand for edges across the footprint; and
+/// at most [`SHARPEST_TURN`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowCorner {
+    pub at: Vec2,
+    pub normals: [Vec2; 2],
+    pub convex: bool,
+}
+
+/// How many footprint radii (t·k) each of a [`ShadowCorner`]'s edges must run from it. The
+/// plateau's ½ (`geometry::plateau::CORNER_REACH`) made corners of most vertices of a
+/// tessellated curve, where the two lines stand for the outline no better than one, and where
+/// the CPU and compute paths then parted at a few pixels (a knot at 128²: 9 px by up to 0.43,
+/// cause not found; V alike within 1.2e-4 at 2): at 2 (512², against the reference, one run)
+/// the sphere's penumbra RMSE is 0.0148 against 0.0106 at ½ (0.0148 without corners), the
+/// torus' 0.0081 against 0.0075, `default`'s 0.0630 against 0.0621, the knot's better (0.0786
+/// against 0.0810 at ½, as without corners), and the polygonal casters' the same.
+pub const CORNER_REACH: f32 = 2.0;
+
+/// The sharpest turn a [`ShadowCorner`] may have, as the cosine between its edges' normals:
+/// 127°, up to which [`CORNER_PIECE`] holds every fragment whose footprint reaches the other
+/// edge's line. Sharper, a spike keeps the smoothies' own V.
+pub const SHARPEST_TURN: f32 = -0.6;
+
+/// How far along its edge from a [`ShadowCorner`] a smoothie piece carries it, in smoothie
+/// widths t·k: a fragment there lies within its footprint's radius (t·k at most) and the quad's
+/// width (t·k) of the edge, and its footprint reaches the other line within that sum over the
+/// sine of the turn, 1.25 times it for turns from 53° up to [`SHARPEST_TURN`]. As the
+/// plateau's sheets are cut (`Sheet::near_corner`), shallower turns are cut there too, where
+/// the two lines part less and the corner moves V less.
+pub const CORNER_PIECE: f32 = 2.5;
 
 /// Which side of the hard edge the smoothies cover (the `penumbra` knob).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,15 +229,28 @@ impl SmoothieGeometry {
         }))
     }
 
-    /// Every vertex, in drawing order: the outer smoothies' ([`Self::outer_vertices`] of them),
-    /// then the inner quads'.
+    /// Every vertex: the outer smoothies', then the inner quads'.
     pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
         self.edges.iter().chain(&self.corners).chain(&self.inner)
     }
 
-    /// How many of [`Self::vertices`] come first, the outer smoothies' (edges and corners).
-    pub fn outer_vertices(&self) -> usize {
-        self.edges.len() + self.corners.len()
+    /// Every triangle in the smoothie pass's drawing order, and how many vertices each of its
+    /// draws takes: the outer smoothies away from the hard shadow's corners, those near one
+    /// ([`SmoothieVertex::turn`]), then the inner quads alike. The smoothies near corners are
+    /// drawn apart, with the corners' arithmetic, which llvmpipe would run on every fragment of
+    /// a draw that held any.
+    pub fn drawn(&self) -> (Vec<SmoothieVertex>, [u32; 4]) {
+        let mut out = Vec::with_capacity(self.vertices().count());
+        let mut counts = [0; 4];
+        let outer = self.edges.chunks(3).chain(self.corners.chunks(3));
+        for (part, triangles) in [outer.collect::<Vec<_>>(), self.inner.chunks(3).collect()].iter().enumerate() {
+            for (near, count) in [false, true].into_iter().zip(&mut counts[2 * part..]) {
+                let before = out.len();
+                out.extend(triangles.iter().filter(|t| (t[0].turn != 0.0) == near).flat_map(|t| t.iter()));
+                *count = (out.len() - before) as u32;
+            }
+        }
+        (out, counts)
     }
 }
 
@@ -232,6 +307,12 @@ fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
         far: 0.0,
         w: 1.0,
         channel: 0.0,
+        cx: 0.0,
+        cy: 0.0,
+        normals: [0.0; 4],
+        turn: 0.0,
+        along: 0.0,
+        keep: KEEP_ALL,
     }
 }
 
@@ -290,6 +371,10 @@ struct End {
     p: Vec2,
     z: f32,
     side: Option<(Vec2, Vec2)>,
+    /// 2 × the edge's number, + 1 at its second end.
+    id: usize,
+    /// The projected edge's length.
+    length: f32,
 }
 
 /// The smoothies of a caster's `edges` (from [`silhouette`]) seen through `view` (the caster's
@@ -320,19 +405,39 @@ pub fn merged_smoothies(
         let p = view.transform_point3(caster.positions[i as usize]);
         (p.z > MIN_DEPTH).then(|| (Vec2::new(p.x, p.y) / p.z, p.z))
     };
-    let mut out = SmoothieGeometry::default();
+    // Each edge's projected ends, and where it is not edge-on its outward normal: away from
+    // the light-facing triangle, across the edge.
+    let projected: Vec<Option<Projected>> = edges
+        .iter()
+        .map(|&MergedEdge { edge: ([a, b], inner), .. }| {
+            let (a, b) = (project(a)?, project(b)?);
+            let along = (b.0 - a.0).try_normalize();
+            let normal = along
+                .zip(project(inner))
+                .map(|(along, (pi, _))| if along.perp().dot(pi - a.0) > 0.0 { -along.perp() } else { along.perp() });
+            Some(([a, b], normal))
+        })
+        .collect();
     let mut ends = Vec::with_capacity(2 * edges.len());
-    for &MergedEdge { edge: ([a, b], inner), inside, outside } in edges {
-        let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
-        let along = (pb - pa).try_normalize();
-        // Outward: away from the light-facing triangle, across the edge.
-        let normal = along
-            .zip(project(inner))
-            .map(|(along, (pi, _))| if along.perp().dot(pi - pa) > 0.0 { -along.perp() } else { along.perp() });
-        let side = |d: f32| along.zip(normal).map(|(along, normal)| (along * d, normal));
-        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0) });
-        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0) });
-        let Some(normal) = normal else { continue };
+    for (i, (e, p)) in edges.iter().zip(&projected).enumerate() {
+        let Some(([(pa, za), (pb, zb)], normal)) = *p else { continue };
+        let side = |d: f32| (pb - pa).try_normalize().zip(normal).map(|(along, normal)| (along * d, normal));
+        let length = (pb - pa).length();
+        let [a, b] = e.edge.0;
+        ends.push(End { vertex: a, p: pa, z: za, side: side(1.0), id: 2 * i, length });
+        ends.push(End { vertex: b, p: pb, z: zb, side: side(-1.0), id: 2 * i + 1, length });
+    }
+    ends.sort_unstable_by_key(|e| e.vertex);
+    let mut out = SmoothieGeometry::default();
+    let mut corner_of = vec![None; 2 * edges.len()];
+    for group in ends.chunk_by(|x, y| x.vertex == y.vertex) {
+        let shadow = shadow_corner(group, (size, receivers), penumbra);
+        group.iter().for_each(|e| corner_of[e.id] = shadow);
+        corner(&mut out, group, (size, receivers), penumbra, shadow);
+    }
+    for (i, (&MergedEdge { inside, outside, .. }, p)) in edges.iter().zip(&projected).enumerate() {
+        let Some(([(pa, za), (pb, zb)], Some(normal))) = *p else { continue };
+        let corners = [corner_of[2 * i], corner_of[2 * i + 1]];
         // Per end: its point, depth and size; the rim lies t · k out, alpha k there, k the
         // reach over the whole quad's receivers (both ends', so the cut is linear in b).
         let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, size.at(z)));
@@ -344,24 +449,138 @@ pub fn merged_smoothies(
             let (p, k) = (p - normal * inside, reach(z, far));
             [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)].map(|v| weighted(v, t))
         });
-        quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
-        if let Penumbra::Centred { near, far: deepest } = penumbra {
-            let range = (near, deepest);
-            let far = far_over(-outside, -normal);
-            let [a, b] = ends.map(|(p, z, t)| {
-                let (p, k) = (p + normal * outside, reach(z, far));
-                let foot = (p, normal);
-                [inner_vertex(p, z, 0.0, foot, range), inner_vertex(p - normal * t * k, z, k, foot, range)]
-                    .map(|v| weighted(v, t))
-            });
-            quad(&mut out.inner, [a[0], b[0], b[1], a[1]]);
-        }
-    }
-    ends.sort_unstable_by_key(|e| e.vertex);
-    for group in ends.chunk_by(|x, y| x.vertex == y.vertex) {
-        corner(&mut out, group, (size, receivers), penumbra);
+        let outer = [a[0], b[0], b[1], a[1]];
+        let Penumbra::Centred { near, far: deepest } = penumbra else {
+            quad(&mut out.edges, outer);
+            continue;
+        };
+        let range = (near, deepest);
+        let far = far_over(-outside, -normal);
+        let [a, b] = ends.map(|(p, z, t)| {
+            let (p, k) = (p + normal * outside, reach(z, far));
+            let foot = (p, normal);
+            [inner_vertex(p, z, 0.0, foot, range), inner_vertex(p - normal * t * k, z, k, foot, range)]
+                .map(|v| weighted(v, t))
+        });
+        let inner = [a[0], b[0], b[1], a[1]];
+        let cuts = corner_cuts(&[outer, inner], corners);
+        edge_quad(&mut out.edges, outer, corners, cuts);
+        edge_quad(&mut out.inner, inner, corners, cuts);
     }
     out
+}
+
+/// Where an edge's quads (its outer and inner, each its base from end a to end b, then its rim
+/// back) are cut for the [`ShadowCorner`]s at its ends: the fractions of the edge from each end
+/// within [`CORNER_PIECE`] widths of the wider quad, meeting in the middle where they would
+/// overlap. Both quads are cut alike: cut apart, their pieces met the hard edge at different
+/// points, and the T-junctions there cracked (a lit speckle on two_boxes' hard edge, V 0.82
+/// for 0.52).
+fn corner_cuts(quads: &[[SmoothieVertex; 4]], corners: [Option<ShadowCorner>; 2]) -> [f32; 2] {
+    let point = |v: SmoothieVertex| Vec2::new(v.x, v.y);
+    let length = point(quads[0][0]).distance(point(quads[0][1]));
+    // The widest rim at end a (base 0, rim 3) and at end b (base 1, rim 2).
+    let width =
+        |base: usize, rim: usize| quads.iter().map(|q| point(q[base]).distance(point(q[rim]))).fold(0.0, f32::max);
+    let reach = |c: Option<ShadowCorner>, width: f32| c.map_or(0.0, |_| CORNER_PIECE * width / length);
+    let [ua, ub] = [reach(corners[0], width(0, 3)), reach(corners[1], width(1, 2))];
+    let apart = ua + ub < 1.0; // false for NaN too
+    match corners {
+        _ if apart => [ua, ub],
+        [Some(_), Some(_)] => [0.5, 0.5],
+        [Some(_), None] => [1.0, 0.0],
+        _ => [0.0, 1.0],
+    }
+}
+
+/// A silhouette edge in the light view's tangent plane: its ends' points and depths, and where
+/// it is not edge-on its outward normal.
+type Projected = ([(Vec2, f32); 2], Option<Vec2>);
+
+/// An edge's quad `q` (its base from end a to end b, then its rim back) in pieces, cut at
+/// `cuts` ([`corner_cuts`]): those within reach of a [`ShadowCorner`] at either end carry it,
+/// the rest none. Each piece reaches [`CUT_MARGIN`] past its cuts and keeps only its own part
+/// of the edge (`keep`), so that every fragment near a cut lies inside the piece that keeps it;
+/// and a sliver over the base comes with it (see below). Each interpolates as the whole quad did
+/// (see [`between`]).
+fn edge_quad(
+    out: &mut Vec<SmoothieVertex>,
+    q: [SmoothieVertex; 4],
+    corners: [Option<ShadowCorner>; 2],
+    cuts: [f32; 2],
+) {
+    if corners == [None; 2] {
+        return quad(out, q);
+    }
+    let [a0, b0, b1, a1] = q.map(|v| SmoothieVertex { along: 0.0, ..v });
+    let [b0, b1] = [b0, b1].map(|v| SmoothieVertex { along: 1.0, ..v });
+    let [ua, ub] = cuts;
+    let point = |v: SmoothieVertex| Vec2::new(v.x, v.y);
+    let width = point(a0).distance(point(a1)).max(point(b0).distance(point(b1)));
+    let margin = CUT_MARGIN * width / point(a0).distance(point(b0));
+    // With each piece, the sliver over the whole hard edge, so that what a piece keeps next to
+    // it is covered from the quad's own base, as uncut: a piece's base runs to a cut's vertex,
+    // which rounds off the hard edge's line, and a texel there that the map calls lit could fall
+    // outside every piece, its outer alpha the clear's (lit speckles at cuts on two_boxes' and
+    // overlap's hard edges, V 0.82 for 0.52).
+    let sliver = between(between(a0, b0, 0.5), between(a1, b1, 0.5), SLIVER);
+    for (u0, u1, corner) in [(0.0, ua, corners[0]), (ua, 1.0 - ub, None), (1.0 - ub, 1.0, corners[1])] {
+        if u0 < u1 {
+            // Beyond the quad's own ends, nothing to keep out; at a cut, both pieces keep a
+            // sliver (KEEP_SLACK) of the other's part, as each interpolates `along` from its own
+            // vertices, and rounding could have left a fragment to neither.
+            let keep =
+                [if u0 > 0.0 { u0 - KEEP_SLACK } else { f32::MIN }, if u1 < 1.0 { u1 + KEEP_SLACK } else { f32::MAX }];
+            let (g0, g1) = ((u0 - margin).max(0.0), (u1 + margin).min(1.0));
+            let piece = [between(a0, b0, g0), between(a0, b0, g1), between(a1, b1, g1), between(a1, b1, g0)];
+            let kept = |v| near_corner(SmoothieVertex { keep, ..v }, corner);
+            quad(out, piece.map(kept));
+            out.extend([a0, b0, sliver].map(kept));
+        }
+    }
+}
+
+/// How far, in smoothie widths (the wider rim), a piece of a cut quad reaches past its cuts
+/// ([`edge_quad`]): a quarter, at least a texel where the grid resolves the smoothie (see the
+/// technique's `PENUMBRA_TEXELS`), and far more than the rasterizer's snapping, 1/256 texel.
+const CUT_MARGIN: f32 = 0.25;
+
+/// How far a cut quad's sliver over its base ([`edge_quad`]) reaches from it at its middle, in
+/// its width: a texel or more wherever a piece keeps fragments off the quad's ends.
+const SLIVER: f32 = 0.125;
+
+/// How much of the other's part of the edge each of two pieces keeps at their cut
+/// ([`edge_quad`]): far more than `along`'s rounding, a few 1e-7, and V there is the same from
+/// both to about as little, the corner's difference having vanished at a cut (overlap: a lit
+/// speckle, V 0.78 for 0.50, where neither kept a fragment).
+const KEEP_SLACK: f32 = 1e-4;
+
+/// The vertex `u` of the way from `a` to `b`, two vertices of one quad's side, with what the
+/// rasterizer interpolates there: position, depth, foot and `along` linearly, the shape projectively by
+/// w = 1/t ([`SmoothieVertex::w`]), so a piece of a quad interpolates as the whole did.
+fn between(a: SmoothieVertex, b: SmoothieVertex, u: f32) -> SmoothieVertex {
+    let lerp = |x: f32, y: f32| x + (y - x) * u;
+    let (ta, tb) = (1.0 / a.w, 1.0 / b.w);
+    let t = lerp(ta, tb);
+    let shape = |x: f32, y: f32| lerp(x * ta, y * tb) / t;
+    SmoothieVertex {
+        x: lerp(a.x, b.x),
+        y: lerp(a.y, b.y),
+        b: lerp(a.b, b.b),
+        sx: shape(a.sx, b.sx),
+        sy: shape(a.sy, b.sy),
+        fx: lerp(a.fx, b.fx),
+        fy: lerp(a.fy, b.fy),
+        w: 1.0 / t,
+        along: lerp(a.along, b.along),
+        ..a
+    }
+}
+
+/// `v` carrying the hard shadow's corner `c`, where there is one.
+fn near_corner(v: SmoothieVertex, c: Option<ShadowCorner>) -> SmoothieVertex {
+    let Some(ShadowCorner { at, normals: [n1, n2], convex }) = c else { return v };
+    SmoothieVertex { cx: at.x, cy: at.y, normals: [n1.x, n1.y, n2.x, n2.y], turn: if convex { 1.0 } else { -1.0 }, ..v }
 }
 
 /// Centred, the smoothie edges of a caster's partial silhouettes (`edges`, from
@@ -440,45 +659,70 @@ pub fn partial_smoothies(
 fn corner(
     out: &mut SmoothieGeometry,
     group: &[End],
-    (size, receivers): (SmoothieSize, ReceiverBound),
+    size: (SmoothieSize, ReceiverBound),
     penumbra: Penumbra,
+    shadow: Option<ShadowCorner>,
 ) {
     let End { p, z, .. } = group[0];
-    let t = size.at(z);
-    // The square of half-size t holds every kind of corner.
-    let square = [Vec2::ONE, Vec2::new(1.0, -1.0), Vec2::NEG_ONE, Vec2::new(-1.0, 1.0)];
-    let k = reach(z, receivers.far_over(square.map(|c| p + c * t)));
-    let at = |offset: Vec2| vertex(p + offset * t, z, offset);
-    if let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group {
-        // Both normals on the same side of the path through the vertex (in along -d1, out along
-        // d2), else one was found from an edge-on triangle, whose third vertex can project to
-        // either side: the square covers whichever is wrong, as it always did. Then the first
-        // normal against the second edge's direction: a convex turn leaves a gap outside, a
-        // concave one inside.
-        let consistent = (-*d1).perp().dot(*n1) * d2.perp().dot(*n2) > 0.0;
-        if let Some(m) = (*n1 + *n2).try_normalize().filter(|_| consistent) {
-            let convex = n1.dot(*d2) < 0.0;
-            match penumbra {
-                _ if convex => wedge(&mut out.corners, [*n1, *n2], m, k, at),
-                Penumbra::Centred { near, far: deepest } if n1.dot(*d2) > 0.0 => {
-                    let inner = |offset| SmoothieVertex {
-                        fx: p.x,
-                        fy: p.y,
-                        nx: m.x,
-                        ny: m.y,
-                        near,
-                        far: deepest,
-                        ..at(offset)
-                    };
-                    wedge(&mut out.inner, [-*n1, -*n2], -m, k, inner);
-                }
-                _ => {}
+    let (t, k) = corner_size(p, z, size);
+    let at = |offset: Vec2| near_corner(weighted(vertex(p + offset * t, z, offset), t), shadow);
+    if let Some(Turn { normals: [n1, n2], bisector: m, bend }) = turn(group) {
+        match penumbra {
+            _ if bend < 0.0 => wedge(&mut out.corners, [n1, n2], m, k, at),
+            Penumbra::Centred { near, far: deepest } if bend > 0.0 => {
+                let inner =
+                    |offset| SmoothieVertex { fx: p.x, fy: p.y, nx: m.x, ny: m.y, near, far: deepest, ..at(offset) };
+                wedge(&mut out.inner, [-n1, -n2], -m, k, inner);
             }
-            return;
+            _ => {}
         }
+        return;
     }
     let c = |sx: f32, sy: f32| at(Vec2::new(sx, sy) * k);
     quad(&mut out.corners, [c(-1.0, -1.0), c(1.0, -1.0), c(1.0, 1.0), c(-1.0, 1.0)]);
+}
+
+/// A corner's smoothie size t at its vertex `p` (depth `z`) and its reach k ([`reach`]) over
+/// the square of half-size t about it, which holds every kind of corner: t·k is the largest
+/// radius of the light's footprint on its receivers.
+fn corner_size(p: Vec2, z: f32, (size, receivers): (SmoothieSize, ReceiverBound)) -> (f32, f32) {
+    let t = size.at(z);
+    let square = [Vec2::ONE, Vec2::new(1.0, -1.0), Vec2::NEG_ONE, Vec2::new(-1.0, 1.0)];
+    (t, reach(z, receivers.far_over(square.map(|c| p + c * t))))
+}
+
+/// How the outline turns at a vertex where exactly two edge ends meet: their outward normals
+/// (in `group`'s order), the bisector, and the bend n1·d2 (d2 the second edge's direction away
+/// from the vertex), below 0 at a convex turn, which leaves a gap outside, above 0 at a concave
+/// one, which leaves it inside.
+struct Turn {
+    normals: [Vec2; 2],
+    bisector: Vec2,
+    bend: f32,
+}
+
+/// The [`Turn`] at a vertex, where both ends have sides and their normals lie on the same side
+/// of the path through it (in along −d1, out along d2); else one was found from an edge-on
+/// triangle, whose third vertex can project to either side.
+fn turn(group: &[End]) -> Option<Turn> {
+    let [End { side: Some((d1, n1)), .. }, End { side: Some((d2, n2)), .. }] = group else { return None };
+    let consistent = (-*d1).perp().dot(*n1) * d2.perp().dot(*n2) > 0.0;
+    let bisector = (*n1 + *n2).try_normalize().filter(|_| consistent)?;
+    Some(Turn { normals: [*n1, *n2], bisector, bend: n1.dot(*d2) })
+}
+
+/// Centred, the hard shadow's corner at a vertex, where its two edges turn by [`MIN_TURN`] to
+/// [`SHARPEST_TURN`] and each runs [`CORNER_REACH`] footprint radii (t·k, [`corner_size`]) or
+/// more from it.
+fn shadow_corner(group: &[End], size: (SmoothieSize, ReceiverBound), penumbra: Penumbra) -> Option<ShadowCorner> {
+    if penumbra == Penumbra::Outer {
+        return None;
+    }
+    let Turn { normals: [n1, n2], bend, .. } = turn(group)?;
+    let (t, k) = corner_size(group[0].p, group[0].z, size);
+    let long = group.iter().all(|e| e.length >= CORNER_REACH * t * k);
+    let turns = n1.perp_dot(n2).abs() > MIN_TURN && n1.dot(n2) >= SHARPEST_TURN && bend != 0.0;
+    (long && turns).then_some(ShadowCorner { at: group[0].p, normals: [n1, n2], convex: bend < 0.0 })
 }
 
 /// The sector from direction `n[0]` to `n[1]` about their bisector `m`, of radius `k` in shape
@@ -561,7 +805,9 @@ mod tests {
         /// A ground plane under the plate, level or tilted (its inverse depth along the ray
         /// (x, y, 1) is g · (x, y, 1)): every smoothie's rim lies where a receiver on it, or in
         /// front of it, already has α' = α / (1 − b/r) ≥ 1, so nothing cut away could darken one;
-        /// and the rim lies well inside the cut the farthest receiver alone allows.
+        /// and the rim lies well inside the cut the farthest receiver alone allows. Outer only:
+        /// centred, the pieces near the plate's corners ([`edge_quad`]) are cut where the reach
+        /// puts them, and their slivers' apexes are no rims; the inner quads take the same reach.
         #[test]
         fn the_ground_cuts_smoothies_where_every_receiver_behind_is_lit(
             height in 0.3f32..5.0,
@@ -575,8 +821,8 @@ mod tests {
             let ground = Vec3::new(tilt * 0.1, 0.0, 0.1);
             let far = 100.0;
             let bound = ReceiverBound { far, ground: Some(ground) };
-            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), bound), CENTRED);
-            let uncut = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), ReceiverBound::up_to(far)), CENTRED);
+            let g = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), bound), Penumbra::Outer);
+            let uncut = smoothies(&down(), &caster, &edges, (SmoothieSize::Fixed(t), ReceiverBound::up_to(far)), Penumbra::Outer);
             prop_assert_eq!(g.vertices().count(), uncut.vertices().count(), "the same smoothies, cut shorter");
             let mut widest = 0.0f32;
             for v in g.vertices().filter(|v| v.sx != 0.0 || v.sy != 0.0) {
@@ -712,12 +958,21 @@ mod tests {
             let edges = silhouette(&caster, &FacePlanes::new(&positions, &triangles), &Mat4::IDENTITY, Vec3::new(0.0, 10.0, 0.0));
             let size = (SmoothieSize::Fixed(t), ReceiverBound::up_to(f32::INFINITY));
             let g = smoothies(&down(), &caster, &edges, size, CENTRED);
-            prop_assert_eq!(g.inner.len(), 4 * 6, "one inner quad per silhouette edge");
             prop_assert_eq!(g.corners.len(), 4 * 12, "a wedge at each convex vertex, nothing over the blocker");
             let half = 0.5 / (10.0 - height);
+            // Each edge's inner quad, whole or in pieces near the corners: every point t/2 inside
+            // the outline is covered.
+            for k in 0..=16 {
+                let along = -half + 2.0 * half * k as f32 / 16.0;
+                for q in [(along, half), (along, -half), (half, along), (-half, along)].map(|(x, y)| Vec2::new(x, y)) {
+                    let inward = if q.x.abs() == half { Vec2::new(-q.x.signum(), 0.0) } else { Vec2::new(0.0, -q.y.signum()) };
+                    let q = q + inward * 0.5 * t;
+                    prop_assert!(g.inner.chunks(3).any(|u| inside(u, q)), "{q} inside the outline uncovered");
+                }
+            }
             for v in &g.inner {
                 let (p, foot, normal) = (Vec2::new(v.x, v.y), Vec2::new(v.fx, v.fy), Vec2::new(v.nx, v.ny));
-                prop_assert!(v.sx == 0.0 || v.sx == 1.0, "alpha 0 on the outline, 1 at t inside it");
+                prop_assert!((0.0..=1.0).contains(&v.sx), "alpha from 0 on the outline to 1 at t inside it");
                 prop_assert!((foot.x.abs().max(foot.y.abs()) - half).abs() < 1e-4, "the foot lies on the outline");
                 prop_assert!((normal.length() - 1.0).abs() < 1e-5 && normal.dot(foot) > 0.0, "outward: {normal}");
                 prop_assert!(((p - foot).dot(normal) + v.sx * t).abs() < 1e-5, "alpha is the depth inside / t");
@@ -756,5 +1011,122 @@ mod tests {
             CENTRED,
         );
         assert!(g.is_empty());
+    }
+
+    /// Two edges at the origin, turning left by `turn` (radians) from +x, the light-facing side
+    /// on the left (convex) or the right (concave), each `length` long, at depth 5: their
+    /// smoothies with a fixed size t.
+    fn turning(turn: f32, convex: bool, length: f32, t: f32, penumbra: Penumbra) -> SmoothieGeometry {
+        let (into, out) = (Vec2::X, Vec2::from_angle(turn));
+        let inside = (out - into) * 0.5 * if convex { 1.0 } else { -1.0 };
+        let points = [-into * length, Vec2::ZERO, out * length, inside * length];
+        let positions: Vec<Vec3> = points.iter().map(|p| p.extend(1.0) * 5.0).collect();
+        let adjacency = EdgeAdjacency::default();
+        let caster = Caster { positions: &positions, triangles: &[], adjacency: &adjacency };
+        let size = (SmoothieSize::Fixed(t), ReceiverBound::up_to(f32::INFINITY));
+        smoothies(&Mat4::IDENTITY, &caster, &[([0, 1], 3), ([1, 2], 3)], size, penumbra)
+    }
+
+    #[test]
+    fn a_shadow_corner_needs_a_turn_long_edges_and_no_spike() {
+        let t = 0.01;
+        let turns = |g: &SmoothieGeometry| -> Vec<f32> {
+            let mut turns: Vec<f32> = g.vertices().map(|v| v.turn).filter(|&turn| turn != 0.0).collect();
+            turns.dedup();
+            turns
+        };
+        for (degrees, length, convex, expected) in [
+            (90.0, 1.0, true, Some(1.0)),
+            (90.0, 1.0, false, Some(-1.0)),
+            (30.0, 1.0, true, Some(1.0)),
+            (125.0, 1.0, false, Some(-1.0)),
+            // Straighter than MIN_TURN: a tessellated curve, not a corner.
+            (0.5, 1.0, true, None),
+            // Sharper than SHARPEST_TURN: a spike.
+            (130.0, 1.0, true, None),
+            // Edges shorter than CORNER_REACH footprints (t · 1 here).
+            (90.0, 1.9 * t, true, None),
+            (90.0, 2.1 * t, true, Some(1.0)),
+        ] {
+            let g = turning(f32::to_radians(degrees), convex, length, t, CENTRED);
+            let want: Vec<f32> = expected.into_iter().collect();
+            assert_eq!(turns(&g), want, "{degrees}°, {length} long, convex {convex}");
+            let corner = g.vertices().find(|v| v.turn != 0.0);
+            if let Some(v) = corner {
+                assert_eq!((v.cx, v.cy), (0.0, 0.0), "the corner's vertex");
+                let [n1, n2] = [Vec2::new(v.normals[0], v.normals[1]), Vec2::new(v.normals[2], v.normals[3])];
+                let side = if convex { -1.0 } else { 1.0 };
+                // Outward: away from the light-facing side, which lies left of the path (convex).
+                assert!(n1.dot(Vec2::new(0.0, side)) > 0.99 || n2.dot(Vec2::new(0.0, side)) > 0.99, "{n1} {n2}");
+            }
+            assert!(turns(&turning(f32::to_radians(degrees), convex, length, t, Penumbra::Outer)).is_empty());
+        }
+    }
+
+    /// Where `q` falls in `tri` (the smoothie pass's interpolation): the shape projectively
+    /// (w = 1/t) and `along` linearly; `None` outside it or where its keep leaves `q` out.
+    fn kept_at(tri: &[SmoothieVertex], q: Vec2) -> Option<(Vec2, f32)> {
+        let p = |k: usize| Vec2::new(tri[k].x, tri[k].y);
+        let area = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
+        let whole = area(p(0), p(1), p(2));
+        if whole == 0.0 || !inside(tri, q) {
+            return None;
+        }
+        let l = [area(q, p(1), p(2)) / whole, area(p(0), q, p(2)) / whole, area(p(0), p(1), q) / whole];
+        let (mut shape, mut weight, mut along) = (Vec2::ZERO, 0.0, 0.0);
+        for (k, v) in tri.iter().enumerate() {
+            shape += l[k] * Vec2::new(v.sx, v.sy) / v.w;
+            weight += l[k] / v.w;
+            along += l[k] * v.along;
+        }
+        (along >= tri[0].keep[0] && along < tri[0].keep[1]).then_some((shape / weight, along))
+    }
+
+    #[test]
+    fn a_cut_quad_s_pieces_interpolate_as_the_whole_and_keep_every_point() {
+        // An edge from (0, 0) to (1, 0), its quad out along +y to t·k, t growing from 0.1 to 0.3
+        // and the reach k falling from 1 to 0.8 (α = y / t throughout); corners at both ends,
+        // cut at 0.2 and 0.3 of the way.
+        let (ta, tb, kb) = (0.1, 0.3, 0.8);
+        let at = |x: f32, t: f32, alpha: f32| weighted(vertex(Vec2::new(x, alpha * t), 1.0, Vec2::X * alpha), t);
+        let q = [at(0.0, ta, 0.0), at(1.0, tb, 0.0), at(1.0, tb, kb), at(0.0, ta, 1.0)];
+        let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::NEG_Y, Vec2::NEG_X], convex: true };
+        let mut out = Vec::new();
+        let cuts = [0.2, 0.3];
+        edge_quad(&mut out, q, [Some(corner), Some(corner)], cuts);
+        for i in 0..=40 {
+            let x = 1e-3 + 0.998 * i as f32 / 40.0;
+            let (t, rim) = (ta + (tb - ta) * x, ta + (tb * kb - ta) * x);
+            for j in 0..=10 {
+                let y = rim * (1e-3 + 0.998 * j as f32 / 10.0);
+                let q = Vec2::new(x, y);
+                let kept: Vec<(&[SmoothieVertex], (Vec2, f32))> =
+                    out.chunks(3).filter_map(|tri| kept_at(tri, q).map(|k| (tri, k))).collect();
+                assert!(!kept.is_empty(), "{q} kept by no piece");
+                for (tri, (shape, along)) in kept {
+                    assert!((shape.x - y / t).abs() < 1e-4 && shape.y.abs() < 1e-6, "{q}: shape {shape}");
+                    assert!((along - x).abs() < 1e-5, "{q}: along {along}");
+                    // Within the cuts' slack both pieces keep it; elsewhere only its own.
+                    let at_cut = [cuts[0], 1.0 - cuts[1]].iter().any(|c| (x - c).abs() < KEEP_SLACK);
+                    let near = x < cuts[0] || x > 1.0 - cuts[1];
+                    assert!(at_cut || (tri[0].turn != 0.0) == near, "{q}: corner {}", tri[0].turn);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn drawn_puts_the_smoothies_near_corners_apart() {
+        let g = turning(f32::to_radians(90.0), true, 1.0, 0.01, CENTRED);
+        let (vertices, counts) = g.drawn();
+        assert_eq!(counts.iter().sum::<u32>() as usize, g.vertices().count());
+        assert!(counts.iter().all(|&c| c > 0 && c % 3 == 0), "every part: {counts:?}");
+        let mut at = 0;
+        for (k, &count) in counts.iter().enumerate() {
+            let part = &vertices[at..at + count as usize];
+            assert!(part.iter().all(|v| (v.turn != 0.0) == (k % 2 == 1)), "part {k}");
+            assert!(part.iter().all(|v| (v.near != 0.0) == (k >= 2)), "part {k}: outer, then inner");
+            at += count as usize;
+        }
     }
 }

@@ -47,6 +47,7 @@ pub struct DeviceInfo {
     pub vulkan_version: String,
     pub max_image_dimension_2d: u32,
     pub max_push_constants_size: u32,
+    pub max_storage_buffer_range: u32,
     pub timestamp_period_ns: f32,
     pub timestamp_valid_bits: u32,
 }
@@ -334,6 +335,7 @@ impl Context {
             ),
             max_image_dimension_2d: limits.max_image_dimension2_d,
             max_push_constants_size: limits.max_push_constants_size,
+            max_storage_buffer_range: limits.max_storage_buffer_range,
             timestamp_period_ns: limits.timestamp_period,
             timestamp_valid_bits: families[parts.queue_family as usize].timestamp_valid_bits,
         };

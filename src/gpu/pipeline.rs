@@ -23,7 +23,7 @@ pub enum Descriptor<'a> {
 pub enum VertexInput {
     /// Generated in the shader (full-screen triangle).
     None,
-    /// Vertices of `stride` bytes; location i reads `attributes[i] = (offset, floats)`: 1 to 3
+    /// Vertices of `stride` bytes; location i reads `attributes[i] = (offset, floats)`: 1 to 4
     /// floats at that byte offset.
     Interleaved { stride: u32, attributes: &'static [(u32, u32)] },
     /// Generated geometry: tightly packed floats, location i taking `floats[i]` of them.
@@ -365,8 +365,12 @@ impl Pipeline {
             .map(|(location, &(offset, floats))| vk::VertexInputAttributeDescription {
                 location: location as u32,
                 binding: 0,
-                format: [vk::Format::R32_SFLOAT, vk::Format::R32G32_SFLOAT, vk::Format::R32G32B32_SFLOAT]
-                    [(floats as usize).clamp(1, 3) - 1],
+                format: [
+                    vk::Format::R32_SFLOAT,
+                    vk::Format::R32G32_SFLOAT,
+                    vk::Format::R32G32B32_SFLOAT,
+                    vk::Format::R32G32B32A32_SFLOAT,
+                ][(floats as usize).clamp(1, 4) - 1],
                 offset,
             })
             .collect();

@@ -44,7 +44,7 @@
 //! outline meet, the truth cuts it by both, and at a right-angled convex corner the apex sees ¾
 //! of the light, not ½ (a reflex one ¼). Centred, the sides near such a corner add the
 //! difference of the two cuts, the footprint taken as the corner vertex's cone (an affine image
-//! of the light's disk, so the area fractions are the disk's: `glsl/plateau/corners.glsl`), and
+//! of the light's disk, so the area fractions are the disk's: `glsl/common/corners.glsl`), and
 //! write the disk-edge distance that gives the sum, its sign the mask's. Far from the corner
 //! the difference is 0, so the sides meet as before. A corner is two edges of the outline that
 //! turn, each at least half a footprint long, whose hard shadow the mask confirms about the

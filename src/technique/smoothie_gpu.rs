@@ -2,7 +2,8 @@
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
 //! invocation per edge finds silhouettes and pairs the edge ends at each silhouette vertex, then
 //! one more appends smoothie edges and corners (`glsl/smoothie/silhouettes.comp`); the smoothie
-//! pass draws them with two indirect draws, the outer smoothies and the inner quads apart. Each
+//! pass draws them with four indirect draws, the outer smoothies and the inner quads apart, each
+//! away from the hard shadow's corners and near them. Each
 //! mesh's positions, triangles, edges and per-vertex stamped slots are uploaded once, while it
 //! is drawn. The output (one copy, not one per frame in flight) is only recomputed when a
 //! caster, the light view or the smoothie size changed: a static scene records no silhouette
@@ -18,8 +19,9 @@ use super::smoothie::penumbra;
 use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
+use crate::geometry::plateau::MIN_TURN;
 use crate::geometry::silhouette::PARTIAL_GAIN;
-use crate::geometry::smoothie::{Penumbra, ReceiverBound, SmoothieSize};
+use crate::geometry::smoothie::{CORNER_PIECE, CORNER_REACH, Penumbra, ReceiverBound, SHARPEST_TURN, SmoothieSize};
 use crate::gpu::{
     Buffer, BufferAccess, Context, DRAW_COMMAND_BYTES, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark,
     Uploads, Variants, buffer_barrier, dispatch, shaders, update_buffer, upload,
@@ -30,8 +32,10 @@ const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
-/// Two `VkDrawIndirectCommand`s: the outer smoothies', then the inner quads'.
-const DRAWS_BYTES: u64 = 2 * DRAW_COMMAND_BYTES;
+/// Four `VkDrawIndirectCommand`s, one per part of the smoothie pass (`smoothie.rs`'s `Part`):
+/// the outer smoothies', away from the hard shadow's corners and near them, then the inner
+/// quads' alike.
+const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -124,7 +128,7 @@ impl GpuSilhouettes {
 
     /// Records the silhouette dispatches of every caster seen through `view`, each from the mesh
     /// `cast` gives its scene object (the shadow mesh the map is drawn from, as on the CPU path);
-    /// returns the vertex buffer and the arguments of the smoothie pass's two indirect draws
+    /// returns the vertex buffer and the arguments of the smoothie pass's four indirect draws
     /// ([`DRAWS_BYTES`]).
     pub fn record(
         &mut self,
@@ -143,21 +147,28 @@ impl GpuSilhouettes {
             .iter()
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
-        // Six vertices per quad: one per edge (two with the inner quads, or a partial
-        // silhouette's two), at most three per corner; as many for each kind in its half of the
-        // buffer (the inner quads', centred).
-        let quads_per_edge = 1 + centred as usize;
+        // Per edge, outer only, a quad of six vertices; centred, up to three pieces of its quad
+        // ([`CORNER_PIECE`]), each with a sliver of three, or a partial silhouette's two quads,
+        // and as many of its inner quad; at most three quads per corner. As many for each kind
+        // in its half of the buffer (the inner quads', centred).
+        let per_edge = if centred { 3 * (6 + 3) } else { 6 };
+        // That bound is every edge a silhouette with a corner at both ends; a silhouette is a
+        // small part of a mesh's edges, and the output is bound as one storage buffer, which may
+        // hold no more than maxStorageBufferRange (128 MiB on lavapipe, which the bound of a full
+        // 20 000-triangle knot passes): no more than that, the shader drops what would not fit.
+        let halves = 1 + u64::from(centred);
+        let most = u64::from(ctx.info.max_storage_buffer_range) / (halves * VERTEX_BYTES);
         let capacity: u64 = casters
             .iter()
-            .map(|o| 6 * (quads_per_edge * o.mesh.adjacency.edges.len() + 3 * o.mesh.positions.len()) as u64)
-            .sum();
-        let halves = 1 + u64::from(centred);
+            .map(|o| (per_edge * o.mesh.adjacency.edges.len() + 6 * 3 * o.mesh.positions.len()) as u64)
+            .sum::<u64>()
+            .clamp(1, most);
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         PerFrame::ensure(
             ctx,
             &mut self.vertices,
             "smoothies",
-            halves * capacity.max(1) * VERTEX_BYTES,
+            halves * capacity * VERTEX_BYTES,
             storage | vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
@@ -177,6 +188,7 @@ impl GpuSilhouettes {
         // Slot 0 holds the one copy of the output (earlier frames may still draw from it: the
         // barriers below order this frame's writes after their reads).
         let (vertices, args) = (self.vertices.as_ref().expect("ensured").range(0), self.args.range(0));
+        let vertices = vk::DescriptorBufferInfo { range: halves * capacity * VERTEX_BYTES, ..vertices };
         let args = vk::DescriptorBufferInfo { range: DRAWS_BYTES, ..args };
         let far = receivers.far;
         let ground = receivers.ground.map_or(Vec4::ZERO, |g| g.extend(1.0));
@@ -206,7 +218,8 @@ impl GpuSilhouettes {
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
                 light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
                 ground,
-                pad: [Vec4::ZERO; 8],
+                corners: Vec4::new(MIN_TURN, CORNER_REACH, SHARPEST_TURN, CORNER_PIECE),
+                pad: [Vec4::ZERO; 7],
             });
         }
         let params_buffer = self.params.as_mut().expect("ensured");
@@ -219,9 +232,12 @@ impl GpuSilhouettes {
         // finish both before this frame's.
         buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::TRANSFER_WRITE);
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
-        // No vertices yet; the outer smoothies drawn from the buffer's start, the inner quads
-        // from its second half.
-        update_buffer(ctx, cmd, args, bytes_of(&[0u32, 1, 0, 0, 0, 1, capacity as u32, 0]));
+        // No vertices yet: each half of the buffer holds one kind, the outer smoothies and the
+        // inner quads, those away from corners appended from its start, those near them from its
+        // end back (silhouettes.comp's quad).
+        let cap = capacity as u32;
+        let draws = [0, cap, cap, 2 * cap].map(|first| [0, 1, first, 0]);
+        update_buffer(ctx, cmd, args, bytes_of(&draws));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
         for (i, &at) in meshes.iter().enumerate() {
             let mesh = self.meshes.get(at);

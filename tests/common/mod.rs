@@ -292,3 +292,79 @@ pub fn static_compute_frames(
     let passes = passes_per_frame(e);
     (frame, first, last, passes)
 }
+
+/// A scene whose hard shadow turns a corner in the middle of a 128² view (between pixels 63 and
+/// 64 both ways), and where the reference's V there must lie.
+pub struct CornerScene {
+    pub scene: Scene,
+    pub truth: std::ops::RangeInclusive<f32>,
+}
+
+/// A plate's corner (half size 1, 1 m up, the light 6 m up, radius 0.5): its hard shadow's
+/// corner at (1.2, 0) sees the light cut by both edges' lines, ¾ of it, where either edge alone
+/// says ½ (the footprint is 0.2 m across, 0.8 m seen: 32 px of 128).
+pub fn plate_corner() -> CornerScene {
+    let object = "[[object]]\nshape = \"plate\"\nsize = [2.0, 0.0, 2.0]\nposition = [0.0, 1.0, -1.0]\n";
+    CornerScene { scene: top_down(1.2, 0.4, [0.0, 6.0, 0.0], 0.5, object), truth: 0.70..=0.80 }
+}
+
+/// An L-shaped slab (two 2 × 1 m arms, 2 cm thick), 1 m up: its outline's one reflex vertex at
+/// the origin, the light 6 m up at (−2.5, −2.5) (radius 0.5), so that its hard shadow's reflex
+/// corner falls at (0.5, 0.5), in the quadrant the slab leaves open, seen from above 0.4 m each
+/// way. The corner sees about a quarter of the light (a right angle seen a little obliquely),
+/// where either edge alone says ½.
+pub fn l_shaped_slab() -> CornerScene {
+    use glam::Vec3;
+    // The outline anticlockwise in (x, z), the reflex vertex (1, 1) moved to the origin; each
+    // triangle wound so that its normal points along `out` (Mesh::new welds equal positions).
+    let outline =
+        [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)].map(|(x, z)| (x - 1.0, z - 1.0));
+    let vertex = |(x, z): (f32, f32), y: f32| Vec3::new(x, y, z);
+    let mut positions = Vec::new();
+    let mut face = |p: [Vec3; 3], out: Vec3| {
+        let flip = (p[1] - p[0]).cross(p[2] - p[0]).dot(out) < 0.0;
+        positions.extend(if flip { [p[0], p[2], p[1]] } else { p });
+    };
+    for k in 1..outline.len() - 1 {
+        let [a, b, c] = [outline[0], outline[k], outline[k + 1]];
+        face([a, b, c].map(|q| vertex(q, 0.01)), Vec3::Y);
+        face([a, b, c].map(|q| vertex(q, -0.01)), -Vec3::Y);
+    }
+    for k in 0..outline.len() {
+        let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
+        let out = Vec3::new(b.1 - a.1, 0.0, a.0 - b.0);
+        face([vertex(a, 0.01), vertex(b, 0.01), vertex(b, -0.01)], out);
+        face([vertex(a, 0.01), vertex(b, -0.01), vertex(a, -0.01)], out);
+    }
+    let triangles = (0..positions.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+    let slab = softshadow::scene::Mesh::new("L-shaped slab", positions, triangles).expect("a closed slab");
+    // A box placed where the slab goes, its mesh then swapped for the slab's.
+    let mut s = scene(
+        "[camera]\nposition = [0.5, 12.0, 0.5]\ntarget = [0.5, 0.0, 0.5]\nup = [0.0, 0.0, -1.0]\n\
+         ortho_half_height = 0.4\n[light]\nposition = [-2.5, 6.0, -2.5]\nradius = 0.5\n[ground]\nheight = 0.0\n\
+         [[object]]\nshape = \"box\"\nsize = [1.0, 1.0, 1.0]\nposition = [0.0, 1.0, 0.0]\n",
+    );
+    s.objects[0].mesh = std::sync::Arc::new(slab);
+    CornerScene { scene: s, truth: 0.15..=0.35 }
+}
+
+/// `technique` (with `sets`) at `c`'s corner within `near` of the reference (the mean of the
+/// four pixels about it), the reference's V there in `c.truth`, and every pixel within
+/// `everywhere` of the reference.
+pub fn sees_at_the_corner(c: &CornerScene, technique: &str, sets: &[(&str, &str)], (near, everywhere): (f32, f32)) {
+    let mut e = engine();
+    let reference = reference(&mut e, &c.scene, 128);
+    let v = render_with(&mut e, &c.scene, technique, sets, 128);
+    finish(e);
+    let around = |c: &Capture| {
+        [(63, 63), (64, 63), (63, 64), (64, 64)].map(|(x, y)| c.visibility_at(x, y)).iter().sum::<f32>() / 4.0
+    };
+    let (corner, truth_corner) = (around(&v), around(&reference));
+    assert!(c.truth.contains(&truth_corner), "the reference's V at the corner {truth_corner}");
+    assert!(
+        (corner - truth_corner).abs() <= near,
+        "{technique} {sets:?}: V at the corner {corner}, the reference's {truth_corner}"
+    );
+    let worst = largest_difference(&v, &reference);
+    assert!(worst <= everywhere, "{technique} {sets:?}: V up to {worst} off the reference");
+}

@@ -1,14 +1,16 @@
-// Centred plateaus at the hard shadow's corners (issue 20). A sheet takes one edge's line: the
+// The hard shadow's corners (issue 20), for centred plateaus (glsl/plateau/penumbra.frag) and
+// smoothies (glsl/smoothie/centred.glsl). A side of the penumbra takes one edge's line: the
 // light's footprint cut by a half plane, V ½ on the hard edge. Where two edges meet, the truth
 // cuts the footprint by both lines: at a convex corner the shadow is the intersection of the
 // edges' inner sides, and its apex sees ¾ of the light, not ½; at a reflex corner, their union,
-// and the apex ¼. Each side near a corner adds the difference between the two models, both
-// computed with the footprint as the vertex cone's ellipse about the fragment (an affine image
-// of the light's disk, so area fractions are the disk's), and writes the disk-edge distance
-// whose curve gives the sum. Far from the corner (the footprint off the other edge's line) the
-// difference is 0 and the side's own t stands, so the sides still meet without a seam.
-#ifndef SOFTSHADOW_PLATEAU_CORNERS_GLSL
-#define SOFTSHADOW_PLATEAU_CORNERS_GLSL
+// and the apex ¼. Near a corner a side takes V from both lines (a plateau's adds the difference
+// between the two models to its own), the footprint an affine image of the light's disk about
+// the fragment (the plateau's vertex cone on its plane; a disk in the smoothie's tangent
+// plane), so area fractions are the disk's, and writes the disk-edge distance whose curve gives
+// it. Far from the corner (the footprint off the other edge's line) both lines give the side's
+// own V, so the sides still meet without a seam.
+#ifndef SOFTSHADOW_CORNERS_GLSL
+#define SOFTSHADOW_CORNERS_GLSL
 #include "disk.glsl"
 
 const float CORNER_PI = 3.14159265358979;
