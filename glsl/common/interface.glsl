@@ -69,7 +69,7 @@ struct SilhouetteParams {
     vec4 ground;      // xyz: the ground's inverse light depth along the ray (x, y, 1); w: 1 where it
                       // bounds the receivers (src/geometry/smoothie.rs's ReceiverBound), else 0
     vec4 corners;     // the hard shadow's corners (src/geometry/smoothie.rs's ShadowCorner): x MIN_TURN,
-                      // y CORNER_REACH, z SHARPEST_TURN, w CORNER_PIECE
+                      // y CORNER_REACH, z SHARPEST_TURN, w PIECE_MARGIN
     vec4 pad[7];
 };
 

@@ -172,6 +172,15 @@ Vertex between(Vertex a, Vertex b, float u) {
                   1.0 / t, lerp(a.along, b.along, u));
 }
 
+// How far along its edges a corner's pieces carry it, in quad widths
+// (src/geometry/smoothie.rs's ShadowCorner::piece).
+float piece(Corner c) {
+    float sharpest = params.corners.z;
+    float most = params.corners.w * (1.0 - sharpest) / sqrt(1.0 - sharpest * sharpest);
+    vec2 n1 = c.normals.xy, n2 = c.normals.zw;
+    return min(params.corners.w * (1.0 + abs(dot(n1, n2))) / abs(n1.x * n2.y - n1.y * n2.x), most);
+}
+
 // Where an edge's outer and inner quads are cut for the corners at its ends, alike
 // (src/geometry/smoothie.rs's corner_cuts).
 vec2 corner_cuts(Vertex outer[4], Vertex inner[4], Corner corners[2]) {
@@ -179,7 +188,7 @@ vec2 corner_cuts(Vertex outer[4], Vertex inner[4], Corner corners[2]) {
     float wa = max(distance(outer[0].p, outer[3].p), distance(inner[0].p, inner[3].p));
     float wb = max(distance(outer[1].p, outer[2].p), distance(inner[1].p, inner[2].p));
     bool a = corners[0].turn != 0.0, b = corners[1].turn != 0.0;
-    float ua = a ? params.corners.w * wa / length : 0.0, ub = b ? params.corners.w * wb / length : 0.0;
+    float ua = a ? piece(corners[0]) * wa / length : 0.0, ub = b ? piece(corners[1]) * wb / length : 0.0;
     if (ua + ub < 1.0) {
         return vec2(ua, ub);
     }

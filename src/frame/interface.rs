@@ -88,7 +88,7 @@ pub struct SilhouetteParams {
     /// receivers (`geometry::smoothie::ReceiverBound`), else 0.
     pub ground: Vec4,
     /// The hard shadow's corners (`geometry::smoothie::ShadowCorner`): x `MIN_TURN`, y its
-    /// `CORNER_REACH`, z `SHARPEST_TURN`, w `CORNER_PIECE`.
+    /// `CORNER_REACH`, z `SHARPEST_TURN`, w `PIECE_MARGIN`.
     pub corners: Vec4,
     pub pad: [Vec4; 7],
 }

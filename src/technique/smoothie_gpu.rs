@@ -21,7 +21,7 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::plateau::MIN_TURN;
 use crate::geometry::silhouette::PARTIAL_GAIN;
-use crate::geometry::smoothie::{CORNER_PIECE, CORNER_REACH, Penumbra, ReceiverBound, SHARPEST_TURN, SmoothieSize};
+use crate::geometry::smoothie::{CORNER_REACH, PIECE_MARGIN, Penumbra, ReceiverBound, SHARPEST_TURN, SmoothieSize};
 use crate::gpu::{
     Buffer, BufferAccess, Context, DRAW_COMMAND_BYTES, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark,
     Uploads, Variants, buffer_barrier, dispatch, shaders, update_buffer, upload,
@@ -148,7 +148,7 @@ impl GpuSilhouettes {
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
         // Per edge, outer only, a quad of six vertices; centred, up to three pieces of its quad
-        // ([`CORNER_PIECE`]), each with a sliver of three, or a partial silhouette's two quads,
+        // (`ShadowCorner::piece`), each with a sliver of three, or a partial silhouette's two quads,
         // and as many of its inner quad; at most three quads per corner. As many for each kind
         // in its half of the buffer (the inner quads', centred).
         let per_edge = if centred { 3 * (6 + 3) } else { 6 };
@@ -218,7 +218,7 @@ impl GpuSilhouettes {
                 counts: [o.mesh.adjacency.edges.len() as u32, self.stamp, capacity as u32, centred as u32],
                 light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
                 ground,
-                corners: Vec4::new(MIN_TURN, CORNER_REACH, SHARPEST_TURN, CORNER_PIECE),
+                corners: Vec4::new(MIN_TURN, CORNER_REACH, SHARPEST_TURN, PIECE_MARGIN),
                 pad: [Vec4::ZERO; 7],
             });
         }
