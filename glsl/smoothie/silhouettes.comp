@@ -188,7 +188,9 @@ vec2 corner_cuts(Vertex outer[4], Vertex inner[4], Corner corners[2]) {
     float wa = max(distance(outer[0].p, outer[3].p), distance(inner[0].p, inner[3].p));
     float wb = max(distance(outer[1].p, outer[2].p), distance(inner[1].p, inner[2].p));
     bool a = corners[0].turn != 0.0, b = corners[1].turn != 0.0;
-    float ua = a ? piece(corners[0]) * wa / length : 0.0, ub = b ? piece(corners[1]) * wb / length : 0.0;
+    // From the corner's vertex, which a turn split by a short edge puts off the edge's end.
+    float ua = a ? (piece(corners[0]) * wa + distance(corners[0].at, outer[0].p)) / length : 0.0;
+    float ub = b ? (piece(corners[1]) * wb + distance(corners[1].at, outer[1].p)) / length : 0.0;
     if (ua + ub < 1.0) {
         return vec2(ua, ub);
     }
@@ -330,25 +332,74 @@ uint other_end(uint i, int k, uint v) {
     return first == 2u * i + uint(k) ? stamps[3u * v + 2u] : first;
 }
 
+// The corner of the lines with outward normals n1 and n2, `at` their meeting point, where they
+// turn as a corner may and `bend` says which way.
+Corner lines_corner(vec2 n1, vec2 n2, vec2 at, float bend) {
+    bool turns = abs(n1.x * n2.y - n1.y * n2.x) > params.corners.x && dot(n1, n2) >= params.corners.z && bend != 0.0;
+    return turns ? Corner(at, vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
+}
+
 // Centred, the hard shadow's corner at end k of edge i, silhouette s (src/geometry/smoothie.rs's
-// shadow_corner).
+// shadow_corner): where both edges are long, at the vertex; where one is shorter than a
+// footprint radius and the outline turns on the same way at its far end into a long edge,
+// where the long edges' lines meet.
 Corner shadow_corner(Silhouette s, uint i, int k) {
     uint v = s.v[k];
+    uint other = other_end(i, k, v);
     vec2 n1, n2, m;
     float bend, other_length;
-    if (params.counts.w == 0u || !turn_at(s, k, stamps[3u * v] & 3u, other_end(i, k, v), n1, n2, m, bend, other_length)) {
+    if (params.counts.w == 0u || !turn_at(s, k, stamps[3u * v] & 3u, other, n1, n2, m, bend, other_length)) {
         return NO_CORNER;
     }
     float t, kk;
     corner_size(s.t[k], s.z[k], t, kk);
     float radius = params.corners.y * t * kk;
-    bool long_enough = distance(s.t[0], s.t[1]) >= radius && other_length >= radius;
-    bool turns = abs(n1.x * n2.y - n1.y * n2.x) > params.corners.x && dot(n1, n2) >= params.corners.z && bend != 0.0;
-    return long_enough && turns ? Corner(s.t[k], vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
+    float own_length = distance(s.t[0], s.t[1]);
+    bool own_long = own_length >= radius, other_long = other_length >= radius;
+    if (own_long && other_long) {
+        return lines_corner(n1, n2, s.t[k], bend);
+    }
+    // The short edge (this one, or the other at this vertex), its end here, and the long one's
+    // normal.
+    Silhouette short_edge = s;
+    uint short_index = i;
+    int short_end = k;
+    vec2 normal = n2;
+    if (own_long == other_long || (own_long && !silhouette(other >> 1u, short_edge))) {
+        return NO_CORNER;
+    }
+    if (own_long) {
+        short_index = other >> 1u;
+        short_end = int(other & 1u);
+        normal = n1;
+    }
+    vec2 p = s.t[k];
+    if (distance(short_edge.t[0], short_edge.t[1]) >= t * kk) {
+        return NO_CORNER;
+    }
+    int far_end = 1 - short_end;
+    uint far = short_edge.v[far_end];
+    vec2 f1, next_normal, fm;
+    float far_bend, next_length;
+    if (!turn_at(short_edge, far_end, stamps[3u * far] & 3u, other_end(short_index, far_end, far), f1, next_normal, fm,
+                 far_bend, next_length) ||
+        next_length < radius || far_bend * bend <= 0.0) {
+        return NO_CORNER;
+    }
+    // Where the two long edges' lines meet (n·x = n·p for each), within a footprint radius of
+    // both vertices.
+    mat2 lines = transpose(mat2(normal, next_normal));
+    vec2 q = short_edge.t[far_end];
+    vec2 at = inverse(lines) * vec2(dot(normal, p), dot(next_normal, q));
+    if (!(distance(at, p) <= t * kk && distance(at, q) <= t * kk)) {
+        return NO_CORNER;
+    }
+    return lines_corner(normal, next_normal, at, bend);
 }
 
-// The corner at end k of silhouette s (edge i), given the vertex's end count and its other end.
-void corner(Silhouette s, uint i, int k, uint count, uint other) {
+// The corner at end k of silhouette s (edge i), given the vertex's end count, its other end and
+// the hard shadow's corner there, `c` (shadow_corner).
+void corner(Silhouette s, int k, uint count, uint other, Corner c) {
     vec2 p = s.t[k];
     float z = s.z[k], t, kk;
     corner_size(p, z, t, kk);
@@ -357,7 +408,6 @@ void corner(Silhouette s, uint i, int k, uint count, uint other) {
     if (turn_at(s, k, count, other, n1, n2, m, bend, other_length)) {
         // As src/geometry/smoothie.rs: a convex turn the outer wedge, a concave one (centred)
         // the inner wedge.
-        Corner c = shadow_corner(s, i, k);
         if (bend < 0.0) {
             wedge(p, z, t, n1, n2, m, kk, OUTER, c);
         } else if (bend > 0.0 && params.counts.w != 0u) {
@@ -483,10 +533,13 @@ void main() {
         }
         return;
     }
+    // Found once per end, for the corner there and the edge's pieces: each call is inlined, and
+    // llvmpipe's compile time grows with them.
+    Corner corners[2] = Corner[2](shadow_corner(s, i, 0), shadow_corner(s, i, 1));
     for (int k = 0; k < 2; k++) {
         uint v = s.v[k];
         if (stamps[3u * v + 1u] == 2u * i + uint(k)) {
-            corner(s, i, k, stamps[3u * v] & 3u, stamps[3u * v + 2u]);
+            corner(s, k, stamps[3u * v] & 3u, stamps[3u * v + 2u], corners[k]);
         }
     }
     if (!s.sided) {
@@ -502,7 +555,6 @@ void main() {
     // the hard shadow's corners.
     Vertex inner[4];
     edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], -s.normal, true, inner);
-    Corner corners[2] = Corner[2](shadow_corner(s, i, 0), shadow_corner(s, i, 1));
     vec2 cuts = corner_cuts(outer, inner, corners);
     edge_pieces(outer, OUTER, corners, cuts);
     edge_pieces(inner, Inner(s.normal, params.size.yw), corners, cuts);
