@@ -46,19 +46,19 @@ float corner_visibility(float part) {
 }
 
 // Whether the light passes both edges of a convex corner where this fragment's footprint meets
-// them: 1.5 map texels outside each edge (smoothie.vert's probe), at the fragment's foot on it,
-// nothing is cast nearer than `far`. Where something is (a caster the corner's caster stands on,
-// or one abutting it), the light beyond that edge's line never reaches the receiver, which sees
-// the other edge alone: on a post standing on a slab, the post's base line taken as a corner's
-// lit both ways lightened the slab behind it by up to 0.46 (6 754 px of 128² leaking 0.1). A
-// reflex corner darkens past either edge alone, as any blocker beyond it would: kept.
+// them: a probe step outside each edge (depth.glsl's probe_step, as smoothie.vert's probe), at the
+// fragment's foot on it, nothing is cast nearer than `far`. Where something is (a caster the
+// corner's caster stands on, or one abutting it), the light beyond that edge's line never reaches
+// the receiver, which sees the other edge alone: on a post standing on a slab, the post's base line
+// taken as a corner's lit both ways lightened the slab behind it by up to 0.46 (6 754 px of 128²
+// leaking 0.1). A reflex corner darkens past either edge alone, as any blocker beyond it would:
+// kept.
 bool corner_open(float far) {
     if (in_turn < 0.0) {
         return true;
     }
     vec2 p = fragment_tangent() - in_corner;
-    vec2 texel = (light.extent.zw - light.extent.xy) / light.bias.w;
-    float step = 1.5 * max(texel.x, texel.y);
+    float step = probe_step(light);
     for (int k = 0; k < 2; k++) {
         vec2 n = k == 0 ? in_normals.xy : in_normals.zw;
         vec2 other = k == 0 ? in_normals.zw : in_normals.xy;
@@ -66,7 +66,7 @@ bool corner_open(float far) {
         vec2 along = vec2(-n.y, n.x);
         along = dot(along, other) > 0.0 ? -along : along;
         vec2 probe = in_corner + along * max(dot(p, along), 0.0) + n * step;
-        float outside = map_at((probe - light.extent.xy) / (light.extent.zw - light.extent.xy));
+        float outside = map_at(tangent_uv(light, probe));
         if (outside < light.kernel.y && outside <= far) {
             return false;
         }

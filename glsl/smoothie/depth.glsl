@@ -5,7 +5,8 @@
 // smoothie pass (its clear) and a quarter of the resolve's fetches. Every depth of the frustum
 // gets the same relative precision, ln(far / near) / 65535 ≤ 1.4e-4 (near ≥ far·1e-4), finer
 // than a half float's 4.9e-4, and the code is monotonic: minimum blending and the resolve's
-// depth comparisons work on codes directly.
+// depth comparisons work on codes directly. Also the light view's window coordinates, which the
+// smoothie shaders' probes of the map share.
 #ifndef SOFTSHADOW_SMOOTHIE_DEPTH_GLSL
 #define SOFTSHADOW_SMOOTHIE_DEPTH_GLSL
 #include "interface.glsl"
@@ -22,6 +23,19 @@ float depth_code(LightView light, float depth) {
 
 vec4 depth_code(LightView light, vec4 depth) {
     return clamp(log2(depth / light.depths.x) / light.depths.z, 0.0, 1.0);
+}
+
+// The light view's window coordinates ([0, 1]², the map's uv) of a point in its tangent plane.
+vec2 tangent_uv(LightView light, vec2 tangent) {
+    return (tangent - light.extent.xy) / (light.extent.zw - light.extent.xy);
+}
+
+// How far outside an edge a probe of the map looks: 1.5 map texels, so the texel there lies
+// wholly outside the caster's own rasterized outline (its centre is at least 0.8 texels from the
+// edge). smoothie.vert's probe and centred.glsl's corner_open both look there.
+float probe_step(LightView light) {
+    vec2 texel = (light.extent.zw - light.extent.xy) / light.bias.w;
+    return 1.5 * max(texel.x, texel.y);
 }
 
 // The depths codes stand for.

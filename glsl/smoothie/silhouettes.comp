@@ -2,6 +2,7 @@
 // Beyond the paper (which found silhouettes on the host, §4): silhouette detection and
 // smoothie generation on the GPU, one invocation per edge, appended into a vertex buffer whose
 // counts feed four indirect draws. Same construction as src/geometry/smoothie.rs.
+#extension GL_EXT_control_flow_attributes : require
 #include "interface.glsl"
 
 layout(local_size_x = 64) in;
@@ -174,11 +175,14 @@ Vertex between(Vertex a, Vertex b, float u) {
 
 // How far along its edges a corner's pieces carry it, in quad widths
 // (src/geometry/smoothie.rs's ShadowCorner::piece).
-float piece(Corner c) {
+float longest_piece() {
     float sharpest = params.corners.z;
-    float most = params.corners.w * (1.0 - sharpest) / sqrt(1.0 - sharpest * sharpest);
+    return params.corners.w * (1.0 - sharpest) / sqrt(1.0 - sharpest * sharpest);
+}
+
+float piece(Corner c) {
     vec2 n1 = c.normals.xy, n2 = c.normals.zw;
-    return min(params.corners.w * (1.0 + abs(dot(n1, n2))) / abs(n1.x * n2.y - n1.y * n2.x), most);
+    return min(params.corners.w * (1.0 + abs(dot(n1, n2))) / abs(n1.x * n2.y - n1.y * n2.x), longest_piece());
 }
 
 // Where an edge's outer and inner quads are cut for the corners at its ends, alike
@@ -223,11 +227,34 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
     }
 }
 
-// Two dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex: PAIRING
-// counts each silhouette vertex's edge ends (stamped, so no clear is needed) and keeps the first
-// two; then each vertex's first end draws its corner, a wedge from both ends' sides where
-// exactly two meet, else a full square.
-layout(constant_id = 1) const bool PAIRING = true;
+// Three dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex and finds
+// each vertex's own corner once: PAIR counts each silhouette vertex's edge ends (stamped, so no
+// clear is needed) and keeps the first two; OWN has each vertex's first end find the hard
+// shadow's corner there (centred); then DRAW, where each vertex's first end draws its corner, a
+// wedge from both ends' sides where exactly two meet, else a full square, and each edge its
+// quads, carrying the corners near its ends. Found in DRAW, the own corners of every vertex a
+// search passed cost minutes a frame on llvmpipe (default at 96²: 4 min).
+const uint PAIR = 0u, OWN = 1u, DRAW = 2u;
+layout(constant_id = 1) const uint STAGE = PAIR;
+
+// Per vertex in `stamps`: the stamped count word, the first two edge ends (PAIR), and the own
+// corner's at, normals and turn as float bits (OWN).
+const uint WORDS = 10u;
+
+void store_corner(uint v, Corner c) {
+    float f[7] = float[7](c.at.x, c.at.y, c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn);
+    for (uint k = 0u; k < 7u; k++) {
+        stamps[WORDS * v + 3u + k] = floatBitsToUint(f[k]);
+    }
+}
+
+Corner own_corner(uint v) {
+    float f[7];
+    for (uint k = 0u; k < 7u; k++) {
+        f[k] = uintBitsToFloat(stamps[WORDS * v + 3u + k]);
+    }
+    return Corner(vec2(f[0], f[1]), vec4(f[2], f[3], f[4], f[5]), f[6]);
+}
 
 // A silhouette edge in the light view: its ends, their depths, and where it is not edge-on its
 // outward normal (`sided`).
@@ -266,10 +293,10 @@ bool silhouette(uint i, out Silhouette s) {
 // The stamped count word of vertex v: this frame's count in the low two bits (saturating).
 uint arrive(uint v) {
     uint stamp = params.counts.y << 2u;
-    uint old = stamps[3u * v];
+    uint old = stamps[WORDS * v];
     for (;;) {
         uint n = (old & ~3u) == stamp ? old & 3u : 0u;
-        uint seen = atomicCompSwap(stamps[3u * v], old, stamp | min(n + 1u, 3u));
+        uint seen = atomicCompSwap(stamps[WORDS * v], old, stamp | min(n + 1u, 3u));
         if (seen == old) {
             return n;
         }
@@ -306,8 +333,7 @@ void corner_size(vec2 p, float z, out float t, out float kk) {
 // How the outline turns at end k of silhouette s, where the pairing found `count` ends at its
 // vertex and `other` beside it (src/geometry/smoothie.rs's Turn): false unless exactly two
 // sided ends meet with their normals on the same side of the path.
-bool turn_at(Silhouette s, int k, uint count, uint other, out vec2 n1, out vec2 n2, out vec2 m, out float bend,
-             out float other_length) {
+bool turn_at(Silhouette s, int k, uint count, uint other, out vec2 n1, out vec2 n2, out vec2 m, out float bend) {
     Silhouette o;
     if (count != 2u || !s.sided || !silhouette(other >> 1u, o) || !o.sided) {
         return false;
@@ -322,79 +348,191 @@ bool turn_at(Silhouette s, int k, uint count, uint other, out vec2 n1, out vec2 
     }
     m = normalize(m);
     bend = dot(n1, d2);
-    other_length = distance(o.t[0], o.t[1]);
     return true;
 }
 
 // The vertex's other end beside end k of edge i.
 uint other_end(uint i, int k, uint v) {
-    uint first = stamps[3u * v + 1u];
-    return first == 2u * i + uint(k) ? stamps[3u * v + 2u] : first;
+    uint first = stamps[WORDS * v + 1u];
+    return first == 2u * i + uint(k) ? stamps[WORDS * v + 2u] : first;
 }
 
-// The corner of the lines with outward normals n1 and n2, `at` their meeting point, where they
-// turn as a corner may and `bend` says which way.
-Corner lines_corner(vec2 n1, vec2 n2, vec2 at, float bend) {
+// No end: where the outline stops at a vertex without exactly two ends.
+const uint NO_END = 0xffffffffu;
+// The most vertices a walk along the outline passes, and how far a run's edges may turn from its
+// chord, over the corner's turn (src/geometry/smoothie.rs's MAX_WALK, RUN_STRAY).
+const int MAX_WALK = 32;
+const float RUN_STRAY = 1.0 / 16.0;
+
+// One step of the outline from the end `code` (2 · edge + end) leaving its vertex: the vertex it
+// arrives at, its point, and the end leaving that onward, NO_END where it has not exactly two
+// (src/geometry/smoothie.rs's Outline::walk).
+void walk(inout uint code, out uint vertex, out vec2 p) {
+    uint e = code >> 1u, k = code & 1u;
+    vertex = k == 0u ? edges[e].y : edges[e].x;
+    vec3 q = view_position(vertex);
+    p = q.xy / q.z;
+    code = (stamps[WORDS * vertex] & 3u) == 2u ? other_end(e, int(1u - k), vertex) : NO_END;
+}
+
+// The outline from p0 along the end `code` to the first vertex at least `length` away: its
+// chord, and how far its edges turn from it (the largest sine; 1 where one runs back); false
+// where the walk ends first (src/geometry/smoothie.rs's Outline::run).
+bool run(uint code, vec2 p0, float length, out vec2 chord, out float stray) {
+    uint c = code, vertex;
+    vec2 p;
+    int steps = -1;
+    [[dont_unroll]] for (int n = 0; n < MAX_WALK && c != NO_END; n++) {
+        walk(c, vertex, p);
+        if (distance(p, p0) >= length) {
+            steps = n;
+            break;
+        }
+    }
+    if (steps < 0) {
+        return false;
+    }
+    chord = (p - p0) / distance(p, p0);
+    stray = 0.0;
+    c = code;
+    vec2 from = p0;
+    [[dont_unroll]] for (int n = 0; n <= steps; n++) {
+        walk(c, vertex, p);
+        vec2 d = (p - from) / distance(p, from);
+        stray = max(stray, dot(chord, d) > 0.0 ? abs(chord.x * d.y - chord.y * d.x) : 1.0);
+        from = p;
+    }
+    return true;
+}
+
+// A run's outward normal: its chord's, on the side of its first edge's normal (Run::normal).
+vec2 run_normal(vec2 chord, vec2 normal) {
+    vec2 n = vec2(-chord.y, chord.x);
+    return dot(n, normal) < 0.0 ? -n : n;
+}
+
+// The corner of the runs with outward normals n1 and n2 and strays `strays`, `at` their meeting
+// point, where they turn as a corner may, `bend` says which way, and both runs are straight
+// enough for it (Run::straight).
+Corner lines_corner(vec2 n1, vec2 n2, vec2 strays, vec2 at, float bend) {
+    float angle = acos(clamp(dot(n1, n2), -1.0, 1.0));
     bool turns = abs(n1.x * n2.y - n1.y * n2.x) > params.corners.x && dot(n1, n2) >= params.corners.z && bend != 0.0;
-    return turns ? Corner(at, vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
+    bool straight = max(strays.x, strays.y) <= RUN_STRAY * angle;
+    return turns && straight ? Corner(at, vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
 }
 
-// Centred, the hard shadow's corner at end k of edge i, silhouette s (src/geometry/smoothie.rs's
-// shadow_corner): where both edges are long, at the vertex; where one is shorter than a
-// footprint radius and the outline turns on the same way at its far end into a long edge,
-// where the long edges' lines meet.
+// Centred, the hard shadow's own corner at end k of edge i, silhouette s
+// (src/geometry/smoothie.rs's shadow_corner): where the outline runs straight far enough along
+// both edges, at the vertex; where one edge is shorter than a footprint radius and the outline
+// turns on the same way at its far end into a straight run, where the runs' lines meet.
 Corner shadow_corner(Silhouette s, uint i, int k) {
     uint v = s.v[k];
     uint other = other_end(i, k, v);
     vec2 n1, n2, m;
-    float bend, other_length;
-    if (params.counts.w == 0u || !turn_at(s, k, stamps[3u * v] & 3u, other, n1, n2, m, bend, other_length)) {
+    float bend;
+    if (params.counts.w == 0u || !turn_at(s, k, stamps[WORDS * v] & 3u, other, n1, n2, m, bend)) {
         return NO_CORNER;
     }
     float t, kk;
     corner_size(s.t[k], s.z[k], t, kk);
     float radius = params.corners.y * t * kk;
-    float own_length = distance(s.t[0], s.t[1]);
-    bool own_long = own_length >= radius, other_long = other_length >= radius;
-    if (own_long && other_long) {
-        return lines_corner(n1, n2, s.t[k], bend);
-    }
-    // The short edge (this one, or the other at this vertex), its end here, and the long one's
-    // normal.
-    Silhouette short_edge = s;
-    uint short_index = i;
-    int short_end = k;
-    vec2 normal = n2;
-    if (own_long == other_long || (own_long && !silhouette(other >> 1u, short_edge))) {
-        return NO_CORNER;
-    }
-    if (own_long) {
-        short_index = other >> 1u;
-        short_end = int(other & 1u);
-        normal = n1;
-    }
     vec2 p = s.t[k];
-    if (distance(short_edge.t[0], short_edge.t[1]) >= t * kk) {
+    vec2 own_chord, other_chord;
+    float own_stray, other_stray;
+    bool own_run = run(2u * i + uint(k), p, radius, own_chord, own_stray);
+    bool other_run = run(other, p, radius, other_chord, other_stray);
+    if (own_run && other_run) {
+        Corner at_vertex = lines_corner(run_normal(own_chord, n1), run_normal(other_chord, n2),
+                                        vec2(own_stray, other_stray), p, bend);
+        if (at_vertex.turn != 0.0) {
+            return at_vertex;
+        }
+    }
+    // Else one edge short, the other's run straight: a turn split in two? The short edge (this
+    // one, or the other at this vertex), its end here, and the long run.
+    Silhouette o;
+    if (!silhouette(other >> 1u, o)) {
         return NO_CORNER;
     }
+    bool own_short = distance(s.t[0], s.t[1]) < t * kk, other_short = distance(o.t[0], o.t[1]) < t * kk;
+    if (own_short == other_short || !(own_short ? other_run : own_run)) {
+        return NO_CORNER;
+    }
+    Silhouette short_edge = own_short ? s : o;
+    uint short_index = own_short ? i : other >> 1u;
+    int short_end = own_short ? k : int(other & 1u);
+    vec2 normal = own_short ? run_normal(other_chord, n2) : run_normal(own_chord, n1);
+    float long_stray = own_short ? other_stray : own_stray;
     int far_end = 1 - short_end;
     uint far = short_edge.v[far_end];
+    uint next = other_end(short_index, far_end, far);
     vec2 f1, next_normal, fm;
-    float far_bend, next_length;
-    if (!turn_at(short_edge, far_end, stamps[3u * far] & 3u, other_end(short_index, far_end, far), f1, next_normal, fm,
-                 far_bend, next_length) ||
-        next_length < radius || far_bend * bend <= 0.0) {
+    float far_bend;
+    vec2 next_chord;
+    float next_stray;
+    vec2 q = short_edge.t[far_end];
+    if (!turn_at(short_edge, far_end, stamps[WORDS * far] & 3u, next, f1, next_normal, fm, far_bend) ||
+        far_bend * bend <= 0.0 || !run(next, q, radius, next_chord, next_stray)) {
         return NO_CORNER;
     }
-    // Where the two long edges' lines meet (n·x = n·p for each), within a footprint radius of
-    // both vertices.
+    next_normal = run_normal(next_chord, next_normal);
+    // Where the two runs' lines meet (n·x = n·p for each), within a footprint radius of both
+    // vertices.
     mat2 lines = transpose(mat2(normal, next_normal));
-    vec2 q = short_edge.t[far_end];
     vec2 at = inverse(lines) * vec2(dot(normal, p), dot(next_normal, q));
     if (!(distance(at, p) <= t * kk && distance(at, q) <= t * kk)) {
         return NO_CORNER;
     }
-    return lines_corner(normal, next_normal, at, bend);
+    return lines_corner(normal, next_normal, vec2(long_stray, next_stray), at, bend);
+}
+
+// Whether p lies on one of c's lines, as straight a run into it would have to be
+// (src/geometry/smoothie.rs's ShadowCorner::holds).
+bool holds(Corner c, vec2 p) {
+    vec2 n1 = c.normals.xy, n2 = c.normals.zw;
+    float slack = RUN_STRAY * acos(clamp(dot(n1, n2), -1.0, 1.0)) * distance(p, c.at);
+    return abs(dot(n1, p - c.at)) <= slack || abs(dot(n2, p - c.at)) <= slack;
+}
+
+// The corner end k of edge i carries (src/geometry/smoothie.rs's corner_near): its vertex's
+// own (OWN's), else the nearest the outline passes on either side whose pieces reach the vertex
+// with a footprint radius to spare and on whose lines it lies, ties to the lower vertex.
+Corner carried_corner(Silhouette s, uint i, int k) {
+    uint v = s.v[k];
+    Corner own = own_corner(v);
+    if (own.turn != 0.0 || (stamps[WORDS * v] & 3u) != 2u) {
+        return own;
+    }
+    vec2 p = s.t[k];
+    float t, kk;
+    corner_size(p, s.z[k], t, kk);
+    float farthest = (longest_piece() + 1.0) * t * kk;
+    uint codes[2] = uint[2](2u * i + uint(k), other_end(i, k, v));
+    Corner best = NO_CORNER;
+    float best_distance = 3.0e38;
+    uint best_vertex = 0xffffffffu;
+    [[dont_unroll]] for (int side = 0; side < 2; side++) {
+        uint code = codes[side], candidate;
+        vec2 q;
+        [[dont_unroll]] for (int n = 0; n < MAX_WALK && code != NO_END; n++) {
+            walk(code, candidate, q);
+            if (distance(q, p) > farthest) {
+                break;
+            }
+            Corner c = own_corner(candidate);
+            if (c.turn != 0.0) {
+                float d = distance(c.at, p);
+                bool nearer = d < best_distance || (d == best_distance && candidate < best_vertex);
+                if (d <= (piece(c) + 1.0) * t * kk && holds(c, p) && nearer) {
+                    best = c;
+                    best_distance = d;
+                    best_vertex = candidate;
+                }
+                break;
+            }
+        }
+    }
+    return best;
 }
 
 // The corner at end k of silhouette s (edge i), given the vertex's end count, its other end and
@@ -404,8 +542,8 @@ void corner(Silhouette s, int k, uint count, uint other, Corner c) {
     float z = s.z[k], t, kk;
     corner_size(p, z, t, kk);
     vec2 n1, n2, m;
-    float bend, other_length;
-    if (turn_at(s, k, count, other, n1, n2, m, bend, other_length)) {
+    float bend;
+    if (turn_at(s, k, count, other, n1, n2, m, bend)) {
         // As src/geometry/smoothie.rs: a convex turn the outer wedge, a concave one (centred)
         // the inner wedge.
         if (bend < 0.0) {
@@ -519,27 +657,37 @@ void main() {
     }
     Silhouette s;
     if (!silhouette(i, s)) {
-        if (!PAIRING) {
+        if (STAGE == DRAW) {
             partial_silhouette(i);
         }
         return;
     }
-    if (PAIRING) {
+    if (STAGE == PAIR) {
         for (uint k = 0u; k < 2u; k++) {
             uint n = arrive(s.v[k]);
             if (n < 2u) {
-                stamps[3u * s.v[k] + 1u + n] = 2u * i + k;
+                stamps[WORDS * s.v[k] + 1u + n] = 2u * i + k;
             }
         }
         return;
     }
-    // Found once per end, for the corner there and the edge's pieces: each call is inlined, and
-    // llvmpipe's compile time grows with them.
-    Corner corners[2] = Corner[2](shadow_corner(s, i, 0), shadow_corner(s, i, 1));
+    // In loops kept rolled: each call is inlined, and llvmpipe's compile time grows with them.
+    if (STAGE == OWN) {
+        [[dont_unroll]] for (int k = 0; k < 2; k++) {
+            if (stamps[WORDS * s.v[k] + 1u] == 2u * i + uint(k)) {
+                store_corner(s.v[k], shadow_corner(s, i, k));
+            }
+        }
+        return;
+    }
+    Corner corners[2];
+    [[dont_unroll]] for (int k = 0; k < 2; k++) {
+        corners[k] = carried_corner(s, i, k);
+    }
     for (int k = 0; k < 2; k++) {
         uint v = s.v[k];
-        if (stamps[3u * v + 1u] == 2u * i + uint(k)) {
-            corner(s, k, stamps[3u * v] & 3u, stamps[3u * v + 2u], corners[k]);
+        if (stamps[WORDS * v + 1u] == 2u * i + uint(k)) {
+            corner(s, k, stamps[WORDS * v] & 3u, stamps[WORDS * v + 2u], corners[k]);
         }
     }
     if (!s.sided) {

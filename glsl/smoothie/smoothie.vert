@@ -2,6 +2,7 @@
 // Smoothie edges, corners and inner quads, generated on the CPU or by silhouettes.comp in the
 // light view's tangent plane.
 #include "interface.glsl"
+#include "depth.glsl"
 
 layout(set = 0, binding = 0) uniform Light { LightView light; };
 
@@ -35,18 +36,11 @@ layout(location = 8) noperspective out float out_size;
 layout(location = 9) noperspective out float out_along;
 layout(location = 10) flat out vec2 out_keep;
 
-vec2 to_uv(vec2 tangent) {
-    return (tangent - light.extent.xy) / (light.extent.zw - light.extent.xy);
-}
-
 void main() {
-    vec2 uv = to_uv(in_tangent_depth.xy);
+    vec2 uv = tangent_uv(light, in_tangent_depth.xy);
     out_b = in_tangent_depth.z;
     out_shape = in_shape;
-    // 1.5 map texels outside the edge: the texel there lies wholly outside the caster's own
-    // rasterized outline (its centre is at least 0.8 texels from the edge).
-    vec2 texel = (light.extent.zw - light.extent.xy) / light.bias.w;
-    out_probe = to_uv(in_foot + in_normal * 1.5 * max(texel.x, texel.y));
+    out_probe = tangent_uv(light, in_foot + in_normal * probe_step(light));
     out_range = in_range;
     out_channel = in_channel;
     out_corner = in_corner;

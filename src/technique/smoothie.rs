@@ -66,10 +66,11 @@
 //! 1.5 → 3.5–3.8, contact 2.7–3.0 → 4.7–4.9, default 3.5–3.8 → 5.2–5.6. A convex corner
 //! lightens only where the light passes both edges (`corner_open`: nothing nearer than the
 //! caster just outside either, as under a post standing on a slab), 0.05–0.3 ms more. A corner
-//! needs each of its edges, not the straight run they lie on, two footprints long: a flat side
-//! cut into short edges keeps ½ at its corners. A turn split by a short edge is one corner, at
-//! the long edges' lines' meeting point (a thin plate lit past its side: 0.22 too dark at its
-//! light-side corners before).
+//! needs the straight runs of the outline into it two footprints long, its lines theirs, so a
+//! flat side cut into short edges turns as its uncut twin does, and the vertices along a run
+//! within reach carry its corner (`geometry::smoothie`'s `Run`, `corner_near`). A turn split by
+//! a short edge is one corner, at the runs' lines' meeting point (a thin plate lit past its
+//! side: 0.22 too dark at its light-side corners before).
 //!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard

@@ -37,6 +37,9 @@ const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::Smoothi
 /// quads' alike.
 const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
 
+/// Words per vertex in a mesh's stamps buffer (silhouettes.comp's WORDS).
+const STAMP_WORDS: usize = 10;
+
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
     positions: Buffer,
@@ -54,8 +57,9 @@ impl MeshBuffers {
         let triangles: Vec<[u32; 4]> = mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
         let edges: Vec<[u32; 4]> =
             mesh.adjacency.edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]).collect();
-        // Per vertex: its stamped edge-end count and its first two edge ends (silhouettes.comp).
-        let stamps = vec![0u32; 3 * mesh.positions.len()];
+        // Per vertex: its stamped edge-end count, its first two edge ends and its own corner
+        // (silhouettes.comp's WORDS).
+        let stamps = vec![0u32; STAMP_WORDS * mesh.positions.len()];
         let mut made: Vec<Buffer> = Vec::new();
         for (name, bytes) in [
             ("silhouette positions", cast_slice::<Vec4, u8>(&positions)),
@@ -84,9 +88,9 @@ impl MeshBuffers {
 
 /// The compute path's pipeline and buffers.
 pub struct GpuSilhouettes {
-    /// The silhouette pipelines, by whether the smoothie size is physical and the dispatch
-    /// pairs edge ends (or draws).
-    pipelines: Variants<(bool, bool)>,
+    /// The silhouette pipelines, by whether the smoothie size is physical and the dispatch's
+    /// stage (silhouettes.comp's STAGE: pairing edge ends, finding corners, drawing).
+    pipelines: Variants<(bool, u32)>,
     meshes: Uploads<MeshId, MeshBuffers>,
     params: Option<PerFrame>,
     vertices: Option<PerFrame>,
@@ -246,11 +250,11 @@ impl GpuSilhouettes {
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
                 range: PARAMS_BYTES,
             };
-            // Pairing the silhouette vertices' edge ends, then drawing: the second dispatch reads
-            // what the first wrote.
-            for pairing in [true, false] {
-                let pipeline = self.pipelines.get((physical, pairing), |&(physical, pairing)| {
-                    let constants = [("PHYSICAL_SIZE", physical as u32), ("PAIRING", pairing as u32)];
+            // Pairing the silhouette vertices' edge ends, finding their corners, then drawing:
+            // each dispatch reads what the ones before wrote.
+            for stage in 0..3 {
+                let pipeline = self.pipelines.get((physical, stage), |&(physical, stage)| {
+                    let constants = [("PHYSICAL_SIZE", physical as u32), ("STAGE", stage)];
                     Pipeline::compute(ctx, "silhouettes", &shaders::SMOOTHIE_SILHOUETTES_COMP, &constants)
                 })?;
                 pipeline.bind(
