@@ -232,8 +232,9 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
 // clear is needed) and keeps the first two; OWN has each vertex's first end find the hard
 // shadow's corner there (centred); then DRAW, where each vertex's first end draws its corner, a
 // wedge from both ends' sides where exactly two meet, else a full square, and each edge its
-// quads, carrying the corners near its ends. Found in DRAW, the own corners of every vertex a
-// search passed cost minutes a frame on llvmpipe (default at 96²: 4 min).
+// quads, carrying the corners near its ends. Found in DRAW, each vertex's own corner would be
+// found again by every search that passed it, each time walking its runs (as the CPU path,
+// which keeps them per vertex, does not).
 const uint PAIR = 0u, OWN = 1u, DRAW = 2u;
 layout(constant_id = 1) const uint STAGE = PAIR;
 
