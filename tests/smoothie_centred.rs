@@ -314,6 +314,25 @@ fn a_turn_split_by_a_short_edge_is_one_corner() {
     finish(e);
 }
 
+/// The same split near contact: `contact`'s slab leans on the ground, and the end edge at its foot,
+/// seen from the light, is shorter than the widest footprint there but far longer than the
+/// footprint on the ground beside the foot, which sees the cut's own line. Taken as the long
+/// edges' corner alone, the sliver the cut leaves went dark where the truth is lit (0.94 too
+/// dark at 128², on both paths; `ShadowCorner::chamfer`).
+#[test]
+fn a_turn_split_by_a_short_edge_leaves_its_cut_lit_near_contact() {
+    let s = suite_scene("contact");
+    let mut e = engine();
+    let truth = reference(&mut e, &s, 128);
+    for sets in [&[][..], &[("gpu_silhouettes", "1")]] {
+        let v = render_with(&mut e, &s, "smoothie", &[CENTRED, sets].concat(), 128);
+        let darker = |(v, t): (&u16, &u16)| (f64::from(*t) - f64::from(*v)) / 65535.0;
+        let darkest = v.visibility.iter().zip(&truth.visibility).map(darker).fold(0.0, f64::max);
+        assert!(darkest <= GROSS_ERROR, "{sets:?}: V {darkest} darker than the truth");
+    }
+    finish(e);
+}
+
 /// Sized to its narrowest smoothie (`penumbra_texels`), which starts on a silhouette: the
 /// sphere's lies on its equator, well above the bottom of its bounds, so its smoothies are twice
 /// as wide as the bounds' deepest point would give, and the CPU path, which knows its

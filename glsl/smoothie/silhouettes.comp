@@ -24,10 +24,10 @@ layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
 // near them from its end back, so that the smoothie pass draws each part with its own shader.
 struct Draw { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
 layout(std430, set = 0, binding = 5) buffer Args { Draw draws[4]; };
-// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel, cx, cy, normals, turn, along, keep
+// x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel, cx, cy, normals, turn, along, keep, chamfer
 // (src/geometry/smoothie.rs's SmoothieVertex)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
-const uint FLOATS = 23u;
+const uint FLOATS = 26u;
 // What a smoothie that is no piece of a cut quad keeps (src/geometry/smoothie.rs's KEEP_ALL).
 const vec2 KEEP_ALL = vec2(-3.40282347e38, 3.40282347e38);
 // How far a piece of a cut quad reaches past its cuts, in smoothie widths (CUT_MARGIN there).
@@ -99,19 +99,23 @@ struct Inner {
 const Inner OUTER = Inner(vec2(0.0), vec2(0.0));
 
 // The hard shadow's corner a smoothie carries (src/geometry/smoothie.rs's ShadowCorner): its
-// vertex, both edges' outward normals, and its turn, 1 convex, -1 reflex; 0: none.
+// vertex, both edges' outward normals, and its turn, 1 convex, -1 reflex; 0: none; and where a
+// short edge splits the turn, that edge's outward normal and how far `at` lies outside its line
+// (zero elsewhere).
 struct Corner {
     vec2 at;
     vec4 normals;
     float turn;
+    vec3 chamfer;
 };
 
-const Corner NO_CORNER = Corner(vec2(0.0), vec4(0.0), 0.0);
+const Corner NO_CORNER = Corner(vec2(0.0), vec4(0.0), 0.0, vec3(0.0));
 
 void put(uint at, Vertex v, Inner inner, Corner c, vec2 keep) {
-    float f[23] = float[23](v.p.x, v.p.y, v.b, v.shape.x, v.shape.y, v.foot.x, v.foot.y, inner.normal.x,
+    float f[26] = float[26](v.p.x, v.p.y, v.b, v.shape.x, v.shape.y, v.foot.x, v.foot.y, inner.normal.x,
                             inner.normal.y, inner.range.x, inner.range.y, v.w, params.light.y, c.at.x, c.at.y,
-                            c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn, v.along, keep.x, keep.y);
+                            c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn, v.along, keep.x, keep.y,
+                            c.chamfer.x, c.chamfer.y, c.chamfer.z);
     for (uint k = 0u; k < FLOATS; k++) {
         vertices[FLOATS * at + k] = f[k];
     }
@@ -239,22 +243,25 @@ const uint PAIR = 0u, OWN = 1u, DRAW = 2u;
 layout(constant_id = 1) const uint STAGE = PAIR;
 
 // Per vertex in `stamps`: the stamped count word, the first two edge ends (PAIR), and the own
-// corner's at, normals and turn as float bits (OWN).
-const uint WORDS = 10u;
+// corner's at, normals, turn and chamfer as float bits (OWN), CORNER_WORDS of them. The stamps
+// buffer is sized from WORDS, which smoothie_gpu.rs sets (STAMP_WORDS).
+const uint CORNER_WORDS = 10u;
+layout(constant_id = 2) const uint WORDS = 13u;
 
 void store_corner(uint v, Corner c) {
-    float f[7] = float[7](c.at.x, c.at.y, c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn);
-    for (uint k = 0u; k < 7u; k++) {
+    float f[CORNER_WORDS] = float[CORNER_WORDS](c.at.x, c.at.y, c.normals.x, c.normals.y, c.normals.z, c.normals.w,
+                                                c.turn, c.chamfer.x, c.chamfer.y, c.chamfer.z);
+    for (uint k = 0u; k < CORNER_WORDS; k++) {
         stamps[WORDS * v + 3u + k] = floatBitsToUint(f[k]);
     }
 }
 
 Corner own_corner(uint v) {
-    float f[7];
-    for (uint k = 0u; k < 7u; k++) {
+    float f[CORNER_WORDS];
+    for (uint k = 0u; k < CORNER_WORDS; k++) {
         f[k] = uintBitsToFloat(stamps[WORDS * v + 3u + k]);
     }
-    return Corner(vec2(f[0], f[1]), vec4(f[2], f[3], f[4], f[5]), f[6]);
+    return Corner(vec2(f[0], f[1]), vec4(f[2], f[3], f[4], f[5]), f[6], vec3(f[7], f[8], f[9]));
 }
 
 // A silhouette edge in the light view: its ends, their depths, and where it is not edge-on its
@@ -419,7 +426,7 @@ Corner lines_corner(vec2 n1, vec2 n2, vec2 strays, vec2 at, float bend) {
     float angle = acos(clamp(dot(n1, n2), -1.0, 1.0));
     bool turns = abs(n1.x * n2.y - n1.y * n2.x) > params.corners.x && dot(n1, n2) >= params.corners.z && bend != 0.0;
     bool straight = max(strays.x, strays.y) <= RUN_STRAY * angle;
-    return turns && straight ? Corner(at, vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0) : NO_CORNER;
+    return turns && straight ? Corner(at, vec4(n1, n2), bend < 0.0 ? 1.0 : -1.0, vec3(0.0)) : NO_CORNER;
 }
 
 // Centred, the hard shadow's own corner at end k of edge i, silhouette s
@@ -484,7 +491,13 @@ Corner shadow_corner(Silhouette s, uint i, int k) {
     if (!(distance(at, p) <= t * kk && distance(at, q) <= t * kk)) {
         return NO_CORNER;
     }
-    return lines_corner(normal, next_normal, vec2(long_stray, next_stray), at, bend);
+    Corner c = lines_corner(normal, next_normal, vec2(long_stray, next_stray), at, bend);
+    // The short edge's line, through both vertices, its normal outward as the edge's own.
+    if (c.turn != 0.0 && q != p) {
+        vec2 cut = run_normal(normalize(q - p), own_short ? n1 : n2);
+        c.chamfer = vec3(cut, dot(cut, at - p));
+    }
+    return c;
 }
 
 // Whether p lies on one of c's lines, as straight a run into it would have to be

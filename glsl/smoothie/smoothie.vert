@@ -21,6 +21,8 @@ layout(location = 9) in float in_turn;
 // Pieces of a cut quad (SmoothieVertex::along): how far along the edge, and the part they keep.
 layout(location = 10) in float in_along;
 layout(location = 11) in vec2 in_keep;
+// A turn split by a short edge (ShadowCorner::chamfer): its line's outward normal and offset.
+layout(location = 12) in vec3 in_chamfer;
 
 // Linear in the buffer but the alpha (`shape`), which w makes distance over size.
 layout(location = 0) noperspective out float out_b;
@@ -35,6 +37,7 @@ layout(location = 7) flat out float out_turn;
 layout(location = 8) noperspective out float out_size;
 layout(location = 9) noperspective out float out_along;
 layout(location = 10) flat out vec2 out_keep;
+layout(location = 11) flat out vec3 out_chamfer;
 
 void main() {
     vec2 uv = tangent_uv(light, in_tangent_depth.xy);
@@ -49,5 +52,6 @@ void main() {
     out_size = 1.0 / in_w;
     out_along = in_along;
     out_keep = in_keep;
+    out_chamfer = in_chamfer;
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0) * in_w;
 }

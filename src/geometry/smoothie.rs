@@ -91,6 +91,9 @@ pub struct SmoothieVertex {
     /// [`KEEP_ALL`] elsewhere.
     pub along: f32,
     pub keep: [f32; 2],
+    /// A turn split by a short edge ([`ShadowCorner::chamfer`]): that edge's outward normal and
+    /// how far the corner lies outside its line; zero elsewhere.
+    pub chamfer: [f32; 3],
 }
 
 /// What a smoothie that is no piece of a cut quad keeps: everything.
@@ -106,6 +109,12 @@ pub struct ShadowCorner {
     pub at: Vec2,
     pub normals: [Vec2; 2],
     pub convex: bool,
+    /// Where the turn is split by a short edge, away from `at` where the lines meet: that edge's
+    /// line, its outward normal m and how far `at` lies outside it, m·(at − p) for p on it. A
+    /// footprint wider than the cut sees the corner at `at`; a narrower one at the cut's foot
+    /// (a receiver near contact) sees the short edge's line and the lit sliver the cut leaves
+    /// (`glsl/smoothie/centred.glsl`'s corner_visibility).
+    pub chamfer: Option<(Vec2, f32)>,
 }
 
 /// How many footprint radii (t·k) each of a [`ShadowCorner`]'s edges must run from it. The
@@ -343,6 +352,7 @@ fn vertex(p: Vec2, b: f32, shape: Vec2) -> SmoothieVertex {
         turn: 0.0,
         along: 0.0,
         keep: KEEP_ALL,
+        chamfer: [0.0; 3],
     }
 }
 
@@ -615,8 +625,16 @@ fn between(a: SmoothieVertex, b: SmoothieVertex, u: f32) -> SmoothieVertex {
 
 /// `v` carrying the hard shadow's corner `c`, where there is one.
 fn near_corner(v: SmoothieVertex, c: Option<ShadowCorner>) -> SmoothieVertex {
-    let Some(ShadowCorner { at, normals: [n1, n2], convex }) = c else { return v };
-    SmoothieVertex { cx: at.x, cy: at.y, normals: [n1.x, n1.y, n2.x, n2.y], turn: if convex { 1.0 } else { -1.0 }, ..v }
+    let Some(ShadowCorner { at, normals: [n1, n2], convex, chamfer }) = c else { return v };
+    let (m, cut) = chamfer.unwrap_or((Vec2::ZERO, 0.0));
+    SmoothieVertex {
+        cx: at.x,
+        cy: at.y,
+        normals: [n1.x, n1.y, n2.x, n2.y],
+        turn: if convex { 1.0 } else { -1.0 },
+        chamfer: [m.x, m.y, cut],
+        ..v
+    }
 }
 
 /// Centred, the smoothie edges of a caster's partial silhouettes (`edges`, from
@@ -866,7 +884,7 @@ fn shadow_corner(
         let angle = n1.dot(n2).clamp(-1.0, 1.0).acos();
         let turns = n1.perp_dot(n2).abs() > MIN_TURN && n1.dot(n2) >= SHARPEST_TURN && bend != 0.0;
         let straight = r1.straight(angle) && r2.straight(angle);
-        (turns && straight).then_some(ShadowCorner { at, normals: [n1, n2], convex: bend < 0.0 })
+        (turns && straight).then_some(ShadowCorner { at, normals: [n1, n2], convex: bend < 0.0, chamfer: None })
     };
     let [r1, r2] = [&group[0], &group[1]].map(run);
     if let (Some(r1), Some(r2)) = (&r1, &r2) {
@@ -895,7 +913,10 @@ fn shadow_corner(
     if !(near(group[0].p) && near(next.p)) {
         return None;
     }
-    corner([(long.0, &long.1), (next_normal, &next_run)], at)
+    // The short edge's line, through both vertices, its normal outward as the edge's own.
+    let cut = (next.p - group[0].p).try_normalize().map(Vec2::perp).zip(short.side);
+    let chamfer = cut.map(|(m, (_, n))| if m.dot(n) < 0.0 { -m } else { m }).map(|m| (m, m.dot(at - group[0].p)));
+    corner([(long.0, &long.1), (next_normal, &next_run)], at).map(|c| ShadowCorner { chamfer, ..c })
 }
 
 /// The corner a vertex without its own ([`shadow_corner`]) carries: the nearest the outline
@@ -1255,16 +1276,20 @@ mod tests {
             let (sin, cos) = degrees.to_radians().sin_cos();
             // The other edge's outward normal, A's turned by the turn.
             let n2 = Vec2::new(sin, cos);
-            let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::Y, n2], convex: true };
+            let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::Y, n2], convex: true, chamfer: None };
             let need = corner.piece() / PIECE_MARGIN;
             let farthest = farthest_reaching(n2);
             assert!(farthest <= need, "{degrees}°: a footprint {farthest} along reaches the other line, pieces {need}");
             assert!(farthest >= need - 0.03, "{degrees}°: pieces {need} for footprints reaching {farthest} along");
         }
-        let right = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::Y, Vec2::X], convex: false };
+        let right = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::Y, Vec2::X], convex: false, chamfer: None };
         assert!((right.piece() - PIECE_MARGIN).abs() < 1e-6, "a right angle needs one width");
-        let shallow =
-            ShadowCorner { at: Vec2::ZERO, normals: [Vec2::Y, Vec2::new(0.5, 0.75_f32.sqrt())], convex: true };
+        let shallow = ShadowCorner {
+            at: Vec2::ZERO,
+            normals: [Vec2::Y, Vec2::new(0.5, 0.75_f32.sqrt())],
+            convex: true,
+            chamfer: None,
+        };
         assert!((shallow.piece() - 2.0 * PIECE_MARGIN).abs() < 1e-5, "a shallow turn cut as the sharpest");
     }
 
@@ -1361,6 +1386,25 @@ mod tests {
     }
 
     #[test]
+    fn a_turn_split_by_a_short_edge_keeps_that_edge_s_line() {
+        // A convex right angle at the origin whose tip a chamfer of 0.42 t cuts off, from
+        // (−0.3 t, 0) to (0, 0.3 t): one corner where the long sides' lines meet, which carries
+        // the chamfer's line, its outward normal and the corner 0.3 t / √2 outside it.
+        let t = 0.01;
+        let (a, b) = (Vec2::new(-0.3 * t, 0.0), Vec2::new(0.0, 0.3 * t));
+        let g = path(&[Vec2::new(-4.0 * t, 0.0), a, b, Vec2::new(0.0, 4.0 * t)], t);
+        assert_eq!(carried(&g), [(Vec2::ZERO, true)]);
+        let m = Vec2::new(1.0, -1.0).normalize();
+        let expected = [m.x, m.y, 0.3 * t / 2.0_f32.sqrt()];
+        for v in g.vertices().filter(|v| v.turn != 0.0) {
+            let off = v.chamfer.iter().zip(expected).map(|(c, e)| (c - e).abs()).fold(0.0, f32::max);
+            assert!(off < 1e-6, "chamfer {:?}, not {expected:?}", v.chamfer);
+        }
+        let uncut = path(&[Vec2::new(-4.0 * t, 0.0), Vec2::ZERO, Vec2::new(0.0, 4.0 * t)], t);
+        assert!(uncut.vertices().all(|v| v.chamfer == [0.0; 3]), "an uncut corner has no chamfer");
+    }
+
+    #[test]
     fn a_tessellated_curve_has_no_corners() {
         // A quarter circle of radius 7.7 t in edges of t/2, each vertex turning 0.065 rad (more
         // than MIN_TURN): chords of two footprints through it turn by 0.26 rad, and its edges
@@ -1416,7 +1460,7 @@ mod tests {
         let (ta, tb, kb) = (0.1, 0.3, 0.8);
         let at = |x: f32, t: f32, alpha: f32| weighted(vertex(Vec2::new(x, alpha * t), 1.0, Vec2::X * alpha), t);
         let q = [at(0.0, ta, 0.0), at(1.0, tb, 0.0), at(1.0, tb, kb), at(0.0, ta, 1.0)];
-        let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::NEG_Y, Vec2::NEG_X], convex: true };
+        let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::NEG_Y, Vec2::NEG_X], convex: true, chamfer: None };
         let mut out = Vec::new();
         let cuts = [0.2, 0.3];
         edge_quad(&mut out, q, [Some(corner), Some(corner)], cuts);

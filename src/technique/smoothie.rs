@@ -70,7 +70,9 @@
 //! flat side cut into short edges turns as its uncut twin does, and the vertices along a run
 //! within reach carry its corner (`geometry::smoothie`'s `Run`, `corner_near`). A turn split by
 //! a short edge is one corner, at the runs' lines' meeting point (a thin plate lit past its
-//! side: 0.22 too dark at its light-side corners before).
+//! side: 0.22 too dark at its light-side corners before), that carries the short edge's line too
+//! for footprints narrower than the cut (contact's slab at its foot: 0.94 too dark at 128²
+//! before; `ShadowCorner::chamfer`).
 //!
 //! Shadow meshes (issue 18, `shadow_mesh_error`): the smoothies and the map of pass 1 are cast
 //! from the same simplified copy of each caster, and the map is fitted to the copies, so the hard
@@ -704,7 +706,7 @@ impl Technique for Smoothie {
                 Vec::new()
             };
             let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, layout.fragment_shader())
-                .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1, 2, 4, 1, 1, 2]))
+                .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1, 2, 4, 1, 1, 2, 3]))
                 .colors(formats)
                 .constants(&constants)
                 .blend(Blend::Min);

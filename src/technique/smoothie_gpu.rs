@@ -37,8 +37,16 @@ const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::Smoothi
 /// quads' alike.
 const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
 
-/// Words per vertex in a mesh's stamps buffer (silhouettes.comp's WORDS).
-const STAMP_WORDS: usize = 10;
+/// Words per vertex in a mesh's stamps buffer: the stamped count, the first two edge ends and the
+/// vertex's own corner (silhouettes.comp's CORNER_WORDS, 10); the shader takes it as WORDS.
+const STAMP_WORDS: u32 = 13;
+
+/// silhouettes.comp's dispatches per caster, in order (its STAGE): pairing the silhouette
+/// vertices' edge ends, finding each vertex's own corner, drawing; each reads what the ones
+/// before wrote.
+const PAIR: u32 = 0;
+const OWN: u32 = 1;
+const DRAW: u32 = 2;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -59,7 +67,7 @@ impl MeshBuffers {
             mesh.adjacency.edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]).collect();
         // Per vertex: its stamped edge-end count, its first two edge ends and its own corner
         // (silhouettes.comp's WORDS).
-        let stamps = vec![0u32; STAMP_WORDS * mesh.positions.len()];
+        let stamps = vec![0u32; STAMP_WORDS as usize * mesh.positions.len()];
         let mut made: Vec<Buffer> = Vec::new();
         for (name, bytes) in [
             ("silhouette positions", cast_slice::<Vec4, u8>(&positions)),
@@ -250,11 +258,9 @@ impl GpuSilhouettes {
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
                 range: PARAMS_BYTES,
             };
-            // Pairing the silhouette vertices' edge ends, finding their corners, then drawing:
-            // each dispatch reads what the ones before wrote.
-            for stage in 0..3 {
+            for stage in [PAIR, OWN, DRAW] {
                 let pipeline = self.pipelines.get((physical, stage), |&(physical, stage)| {
-                    let constants = [("PHYSICAL_SIZE", physical as u32), ("STAGE", stage)];
+                    let constants = [("PHYSICAL_SIZE", physical as u32), ("STAGE", stage), ("WORDS", STAMP_WORDS)];
                     Pipeline::compute(ctx, "silhouettes", &shaders::SMOOTHIE_SILHOUETTES_COMP, &constants)
                 })?;
                 pipeline.bind(
