@@ -275,17 +275,22 @@ impl SmoothieGeometry {
 
     /// Every triangle in the smoothie pass's drawing order, and how many vertices each of its
     /// draws takes: the outer smoothies away from the hard shadow's corners, those near one
-    /// ([`SmoothieVertex::turn`]), then the inner quads alike. The smoothies near corners are
-    /// drawn apart, with the corners' arithmetic, which llvmpipe would run on every fragment of
-    /// a draw that held any.
-    pub fn drawn(&self) -> (Vec<SmoothieVertex>, [u32; 4]) {
+    /// ([`SmoothieVertex::turn`]), those near a chamfered one ([`SmoothieVertex::chamfer`]),
+    /// then the inner quads alike. Each kind is drawn apart, with its own arithmetic, which
+    /// llvmpipe would run on every fragment of a draw that held any.
+    pub fn drawn(&self) -> (Vec<SmoothieVertex>, [u32; 6]) {
+        let kind = |v: &SmoothieVertex| match (v.turn != 0.0, v.chamfer != [0.0; 3]) {
+            (false, _) => 0,
+            (true, false) => 1,
+            (true, true) => 2,
+        };
         let mut out = Vec::with_capacity(self.vertices().count());
-        let mut counts = [0; 4];
+        let mut counts = [0; 6];
         let outer = self.edges.chunks(3).chain(self.corners.chunks(3));
         for (part, triangles) in [outer.collect::<Vec<_>>(), self.inner.chunks(3).collect()].iter().enumerate() {
-            for (near, count) in [false, true].into_iter().zip(&mut counts[2 * part..]) {
+            for (k, count) in counts[3 * part..3 * part + 3].iter_mut().enumerate() {
                 let before = out.len();
-                out.extend(triangles.iter().filter(|t| (t[0].turn != 0.0) == near).flat_map(|t| t.iter()));
+                out.extend(triangles.iter().filter(|t| kind(&t[0]) == k).flat_map(|t| t.iter()));
                 *count = (out.len() - before) as u32;
             }
         }
@@ -1487,15 +1492,22 @@ mod tests {
 
     #[test]
     fn drawn_puts_the_smoothies_near_corners_apart() {
-        let g = turning(f32::to_radians(90.0), true, 1.0, 0.01, CENTRED);
+        let t = 0.01;
+        // A right angle, and a chamfered one (a_turn_split_by_a_short_edge_keeps_that_edge_s_line).
+        let mut g = turning(f32::to_radians(90.0), true, 1.0, t, CENTRED);
+        g.extend(&path(
+            &[Vec2::new(-4.0 * t, 0.0), Vec2::new(-0.3 * t, 0.0), Vec2::new(0.0, 0.3 * t), Vec2::new(0.0, 4.0 * t)],
+            t,
+        ));
         let (vertices, counts) = g.drawn();
         assert_eq!(counts.iter().sum::<u32>() as usize, g.vertices().count());
         assert!(counts.iter().all(|&c| c > 0 && c % 3 == 0), "every part: {counts:?}");
         let mut at = 0;
         for (k, &count) in counts.iter().enumerate() {
             let part = &vertices[at..at + count as usize];
-            assert!(part.iter().all(|v| (v.turn != 0.0) == (k % 2 == 1)), "part {k}");
-            assert!(part.iter().all(|v| (v.near != 0.0) == (k >= 2)), "part {k}: outer, then inner");
+            assert!(part.iter().all(|v| (v.turn != 0.0) == (k % 3 != 0)), "part {k}: corners");
+            assert!(part.iter().all(|v| (v.chamfer != [0.0; 3]) == (k % 3 == 2)), "part {k}: chamfers");
+            assert!(part.iter().all(|v| (v.near != 0.0) == (k >= 3)), "part {k}: outer, then inner");
             at += count as usize;
         }
     }

@@ -701,7 +701,11 @@ impl Technique for Smoothie {
         let draws = source.draws(layout.centred());
         let make = |&(layout, part): &(Buffer, Part)| {
             let constants = if layout.centred() {
-                vec![("INNER", u32::from(part.inner)), ("CORNERS", u32::from(part.corners))]
+                vec![
+                    ("INNER", u32::from(part.inner)),
+                    ("CORNERS", u32::from(part.corners)),
+                    ("CHAMFER", u32::from(part.chamfer)),
+                ]
             } else {
                 Vec::new()
             };
@@ -867,7 +871,7 @@ enum Smoothies {
     /// [`Part`] (in the order of [`Part::ALL`]).
     Direct {
         vertices: vk::DescriptorBufferInfo,
-        counts: [u32; 4],
+        counts: [u32; 6],
     },
     /// The compute path's: an indirect draw per [`Part`], one after the other in `args`.
     Indirect {
@@ -881,7 +885,11 @@ impl Smoothies {
     /// The draws of the smoothie pass, one per [`Part`]; into the paper's buffer (`centred`
     /// false) only the outer smoothies away from corners, the only part there is.
     fn draws(&self, centred: bool) -> Vec<(Part, Draw)> {
-        let parts = if centred { &Part::ALL[..] } else { &Part::ALL[..1] };
+        let all = match self {
+            Smoothies::Indirect { .. } => &Part::INDIRECT[..],
+            _ => &Part::ALL[..],
+        };
+        let parts = if centred { all } else { &all[..1] };
         let draw = |(i, &part): (usize, &Part)| match *self {
             Smoothies::Direct { vertices, counts } => {
                 let first = counts[..i].iter().sum();
@@ -905,7 +913,8 @@ enum Draw {
 }
 
 /// Which smoothies a draw of the smoothie pass holds: the outer smoothies or the inner quads
-/// (`INNER`, glsl/smoothie/centred.glsl), near the hard shadow's corners or not (`CORNERS`).
+/// (`INNER`, glsl/smoothie/centred.glsl), near the hard shadow's corners or not (`CORNERS`),
+/// chamfered ones among them or not (`CHAMFER`).
 /// Centred, each is drawn apart, running only its own part of the shader, since llvmpipe runs
 /// both branches of a test it cannot fold. Outer and inner drawn together, every fragment ran
 /// both; the images are the same bit for bit (the suite, both paths), and apart the smoothie
@@ -917,15 +926,30 @@ enum Draw {
 struct Part {
     inner: bool,
     corners: bool,
+    chamfer: bool,
 }
 
 impl Part {
-    /// Every part, in drawing order.
-    const ALL: [Part; 4] = [
-        Part { inner: false, corners: false },
-        Part { inner: false, corners: true },
-        Part { inner: true, corners: false },
-        Part { inner: true, corners: true },
+    /// The CPU path's parts, in drawing order (`SmoothieGeometry::drawn`): the chamfered corners
+    /// apart, whose three line pairs cost twice the corner's arithmetic again; drawn with the
+    /// others, every corner fragment paid it (contact's smoothie pass 5.9 → 7.3 ms, the least of
+    /// six interleaved medians of 30 frames each, 512², lavapipe).
+    const ALL: [Part; 6] = [
+        Part { inner: false, corners: false, chamfer: false },
+        Part { inner: false, corners: true, chamfer: false },
+        Part { inner: false, corners: true, chamfer: true },
+        Part { inner: true, corners: false, chamfer: false },
+        Part { inner: true, corners: true, chamfer: false },
+        Part { inner: true, corners: true, chamfer: true },
+    ];
+
+    /// The compute path's, one indirect draw each (silhouettes.comp's `Args`): its corners,
+    /// chamfered or not, in one draw, whose every fragment pays the chamfer's arithmetic.
+    const INDIRECT: [Part; 4] = [
+        Part { inner: false, corners: false, chamfer: false },
+        Part { inner: false, corners: true, chamfer: true },
+        Part { inner: true, corners: false, chamfer: false },
+        Part { inner: true, corners: true, chamfer: true },
     ];
 }
 
