@@ -47,9 +47,10 @@ vec2 fragment_tangent() {
 // edge's and one long edge's, which leave lit the sliver the cut takes off the corner (contact's
 // slab at its foot: 0.4–0.9 too dark in a row of 7 px at 512² with the corner's two alone).
 // Unless the map says otherwise between the cut and the corner, `covered` saying whether it holds
-// a caster at this texel: there the two models disagree, and where the map takes the corner's
-// side, something the three lines leave out is there (default's wingnut: 4 px lit to 0.89 for
-// 0.35 where its wing's shadow meets its body's).
+// a caster at this texel (an inner fragment's own caster, an outer one's anything at its depth or
+// nearer): there the two models disagree, and where the map takes the corner's side (a caster at
+// a convex turn, none at a reflex one), something the three lines leave out is there (default's
+// wingnut: 4 px lit to 0.89 for 0.35 where its wing's shadow meets its body's).
 float corner_visibility(float part, bool covered) {
     vec2 p = fragment_tangent() - in_corner;
     float radius = max(in_size * part, 1e-30);
@@ -65,13 +66,10 @@ float corner_visibility(float part, bool covered) {
     if (in_cut && covered == convex) {
         return v;
     }
-    // The cut's end nearer the fragment: on the long edge whose line lies nearer. The farther
-    // end's pair matters only to a footprint that reaches both ends, wider than the cut, where
-    // the corner's own pair is the nearer bound; leaving it out saves a third of the arithmetic.
     vec3 cut = vec3(in_chamfer.xy, beyond / radius);
-    bool first = abs(one.z) < abs(other.z);
-    float at_end = corner_v(first ? one : cut, first ? cut : other, convex);
-    return convex ? max(v, at_end) : min(v, at_end);
+    float at_ends = convex ? max(corner_v(one, cut, true), corner_v(cut, other, true))
+                           : min(corner_v(one, cut, false), corner_v(cut, other, false));
+    return convex ? max(v, at_ends) : min(v, at_ends);
 }
 
 // Whether the light passes both edges of a convex corner where this fragment's footprint meets

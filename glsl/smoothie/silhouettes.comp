@@ -18,7 +18,7 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
-// Four indirect draws, one per part of the smoothie pass (smoothie.rs's `Part`): the outer
+// Four indirect draws, one per part of the smoothie pass (smoothie.rs's `Part::INDIRECT`): the outer
 // smoothies away from the hard shadow's corners and near them, then the inner quads alike. Each
 // kind takes a half of the vertex buffer, those away from corners appended from its start, those
 // near them from its end back, so that the smoothie pass draws each part with its own shader.

@@ -873,7 +873,7 @@ enum Smoothies {
         vertices: vk::DescriptorBufferInfo,
         counts: [u32; 6],
     },
-    /// The compute path's: an indirect draw per [`Part`], one after the other in `args`.
+    /// The compute path's: an indirect draw per part of [`Part::INDIRECT`], one after the other in `args`.
     Indirect {
         vertices: vk::DescriptorBufferInfo,
         args: vk::DescriptorBufferInfo,
@@ -932,8 +932,9 @@ struct Part {
 impl Part {
     /// The CPU path's parts, in drawing order (`SmoothieGeometry::drawn`): the chamfered corners
     /// apart, whose three line pairs cost twice the corner's arithmetic again; drawn with the
-    /// others, every corner fragment paid it (contact's smoothie pass 5.9 → 7.3 ms, the least of
-    /// six interleaved medians of 30 frames each, 512², lavapipe).
+    /// others, every corner fragment paid it. contact's smoothie pass, the least of five or six
+    /// interleaved medians of 30 frames each (512², lavapipe): 5.9 ms before the chamfers, 7.3
+    /// with every corner paying them, 6.7 with them apart (6.1 with their arithmetic off).
     const ALL: [Part; 6] = [
         Part { inner: false, corners: false, chamfer: false },
         Part { inner: false, corners: true, chamfer: false },

@@ -32,7 +32,7 @@ const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
-/// Four `VkDrawIndirectCommand`s, one per part of the smoothie pass (`smoothie.rs`'s `Part`):
+/// Four `VkDrawIndirectCommand`s, one per part of the smoothie pass (`smoothie.rs`'s `Part::INDIRECT`):
 /// the outer smoothies', away from the hard shadow's corners and near them, then the inner
 /// quads' alike.
 const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
