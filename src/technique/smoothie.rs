@@ -932,9 +932,9 @@ struct Part {
 impl Part {
     /// The CPU path's parts, in drawing order (`SmoothieGeometry::drawn`): the chamfered corners
     /// apart, whose three line pairs cost twice the corner's arithmetic again; drawn with the
-    /// others, every corner fragment paid it. contact's smoothie pass, the least of five or six
-    /// interleaved medians of 30 frames each (512², lavapipe): 5.9 ms before the chamfers, 7.3
-    /// with every corner paying them, 6.7 with them apart (6.1 with their arithmetic off).
+    /// others, every corner fragment paid it. contact's smoothie pass (512², lavapipe, medians of
+    /// six interleaved runs of 40 frames): 5.92 ms before the chamfers, 7.3 with every corner
+    /// paying them, 6.65 with them apart (6.02 with their arithmetic off).
     const ALL: [Part; 6] = [
         Part { inner: false, corners: false, chamfer: false },
         Part { inner: false, corners: true, chamfer: false },
