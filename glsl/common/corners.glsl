@@ -38,11 +38,15 @@ float chord_term(vec2 u, float d, vec2 v, float e) {
     return hi > lo ? 0.5 * corner_cross(o + hi * t, o + lo * t) : 0.0;
 }
 
+// u2's angle from u1's, in [−π, π].
+float corner_angle(vec2 u1, vec2 u2) {
+    return atan(corner_cross(u1, u2), dot(u1, u2));
+}
+
 // The angle of the unit circle inside both half planes u·x ≥ d: two arcs, each about u's
-// angle, acos d either side of it.
-float arcs_inside(vec2 u1, float d1, vec2 u2, float d2) {
+// angle, acos d either side of it, u2's `delta` from u1's.
+float arcs_inside(float d1, float d2, float delta) {
     float h1 = acos(clamp(d1, -1.0, 1.0)), h2 = acos(clamp(d2, -1.0, 1.0));
-    float delta = atan(corner_cross(u1, u2), dot(u1, u2)); // u2's angle from u1's, in [−π, π]
     float sum = 0.0;
     for (int k = -1; k <= 1; k++) {
         float s = delta + 2.0 * CORNER_PI * float(k);
@@ -51,10 +55,10 @@ float arcs_inside(vec2 u1, float d1, vec2 u2, float d2) {
     return sum;
 }
 
-// The fraction of the unit disk in {u1·x ≥ d1} ∩ {u2·x ≥ d2} (u unit): Green's theorem over the
-// region's boundary, its arcs and its two chords.
-float disk_in_both(vec2 u1, float d1, vec2 u2, float d2) {
-    float area = 0.5 * arcs_inside(u1, d1, u2, d2) + chord_term(u1, d1, u2, d2) + chord_term(u2, d2, u1, d1);
+// The fraction of the unit disk in {u1·x ≥ d1} ∩ {u2·x ≥ d2} (u unit, u2 at `delta` from u1:
+// corner_angle): Green's theorem over the region's boundary, its arcs and its two chords.
+float disk_in_both(vec2 u1, float d1, vec2 u2, float d2, float delta) {
+    float area = 0.5 * arcs_inside(d1, d2, delta) + chord_term(u1, d1, u2, d2) + chord_term(u2, d2, u1, d1);
     return clamp(area / CORNER_PI, 0.0, 1.0);
 }
 
@@ -86,10 +90,18 @@ bool footprint_line(mat2 axes, vec2 n, vec2 p, out vec3 line) {
 
 // V under both of a corner's lines (footprint_line), `convex` the turn: at a convex corner the
 // shadow is both inner sides, V = 1 − the disk in both; at a reflex one, either, and V the disk
-// in both outer sides.
+// in both outer sides, the same lines mirrored. One disk_in_both for either turn: llvmpipe runs
+// both arms of a choice it cannot fold, and a call in each arm cost every corner fragment two.
+// `delta`: other's normal's angle from one's (corner_angle; mirrored alike), which a caller whose
+// lines keep their directions across a primitive finds once per vertex.
+float corner_v_turned(vec3 one, vec3 other, bool convex, float delta) {
+    float s = convex ? 1.0 : -1.0;
+    float inside = disk_in_both(s * one.xy, s * one.z, s * other.xy, s * other.z, delta);
+    return convex ? 1.0 - inside : inside;
+}
+
 float corner_v(vec3 one, vec3 other, bool convex) {
-    return convex ? 1.0 - disk_in_both(one.xy, one.z, other.xy, other.z)
-                  : disk_in_both(-one.xy, -one.z, -other.xy, -other.z);
+    return corner_v_turned(one, other, convex, corner_angle(one.xy, other.xy));
 }
 
 #endif

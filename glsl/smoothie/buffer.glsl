@@ -21,6 +21,7 @@ layout(location = 8) noperspective in float in_size;
 layout(location = 9) noperspective in float in_along;
 layout(location = 10) flat in vec2 in_keep;
 layout(location = 11) flat in vec3 in_chamfer;
+layout(location = 12) flat in vec3 in_angles;
 
 float map_at(vec2 uv) {
     float size = light.bias.w;

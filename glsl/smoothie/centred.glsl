@@ -57,7 +57,7 @@ float corner_visibility(float part, bool covered) {
     vec3 one = vec3(in_normals.xy, dot(in_normals.xy, p) / radius);
     vec3 other = vec3(in_normals.zw, dot(in_normals.zw, p) / radius);
     bool convex = in_turn > 0.0;
-    float v = corner_v(one, other, convex);
+    float v = corner_v_turned(one, other, convex, in_angles.x);
     if (!CHAMFER || dot(in_chamfer.xy, in_chamfer.xy) == 0.0) {
         return v;
     }
@@ -67,9 +67,8 @@ float corner_visibility(float part, bool covered) {
         return v;
     }
     vec3 cut = vec3(in_chamfer.xy, beyond / radius);
-    float at_ends = convex ? max(corner_v(one, cut, true), corner_v(cut, other, true))
-                           : min(corner_v(one, cut, false), corner_v(cut, other, false));
-    return convex ? max(v, at_ends) : min(v, at_ends);
+    float a = corner_v_turned(one, cut, convex, in_angles.y), b = corner_v_turned(cut, other, convex, in_angles.z);
+    return convex ? max(v, max(a, b)) : min(v, min(a, b));
 }
 
 // Whether the light passes both edges of a convex corner where this fragment's footprint meets

@@ -3,6 +3,7 @@
 // light view's tangent plane.
 #include "interface.glsl"
 #include "depth.glsl"
+#include "corners.glsl"
 
 layout(set = 0, binding = 0) uniform Light { LightView light; };
 
@@ -38,6 +39,9 @@ layout(location = 8) noperspective out float out_size;
 layout(location = 9) noperspective out float out_along;
 layout(location = 10) flat out vec2 out_keep;
 layout(location = 11) flat out vec3 out_chamfer;
+// The angles between the corner's lines' normals (corners.glsl's corner_angle), the same for
+// every fragment: the long edges', the first's to the cut's, the cut's to the second's.
+layout(location = 12) flat out vec3 out_angles;
 
 void main() {
     vec2 uv = tangent_uv(light, in_tangent_depth.xy);
@@ -53,5 +57,7 @@ void main() {
     out_along = in_along;
     out_keep = in_keep;
     out_chamfer = in_chamfer;
+    vec2 n1 = in_normals.xy, n2 = in_normals.zw, m = in_chamfer.xy;
+    out_angles = vec3(corner_angle(n1, n2), corner_angle(n1, m), corner_angle(m, n2));
     gl_Position = vec4(uv * 2.0 - 1.0, 0.0, 1.0) * in_w;
 }

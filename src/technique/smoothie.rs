@@ -934,7 +934,8 @@ impl Part {
     /// apart, whose three line pairs cost twice the corner's arithmetic again; drawn with the
     /// others, every corner fragment paid it. contact's smoothie pass (512², lavapipe, medians of
     /// six interleaved runs of 40 frames): 5.92 ms before the chamfers, 7.3 with every corner
-    /// paying them, 6.65 with them apart (6.02 with their arithmetic off).
+    /// paying them, 6.65 with them apart (6.02 with their arithmetic off), 5.85–5.99 since
+    /// corners.glsl's corner_v runs one disk_in_both and takes the angles from the vertices.
     const ALL: [Part; 6] = [
         Part { inner: false, corners: false, chamfer: false },
         Part { inner: false, corners: true, chamfer: false },
