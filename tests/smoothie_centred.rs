@@ -325,10 +325,8 @@ fn a_turn_split_by_a_short_edge_leaves_its_cut_lit_near_contact() {
     let mut e = engine();
     let truth = reference(&mut e, &s, 128);
     for sets in [&[][..], &[("gpu_silhouettes", "1")]] {
-        let v = render_with(&mut e, &s, "smoothie", &[CENTRED, sets].concat(), 128);
-        let darker = |(v, t): (&u16, &u16)| (f64::from(*t) - f64::from(*v)) / 65535.0;
-        let darkest = v.visibility.iter().zip(&truth.visibility).map(darker).fold(0.0, f64::max);
-        assert!(darkest <= GROSS_ERROR, "{sets:?}: V {darkest} darker than the truth");
+        let m = Metrics::between(&render_with(&mut e, &s, "smoothie", &[CENTRED, sets].concat(), 128), &truth).unwrap();
+        assert_eq!(m.dark_rate, 0.0, "{sets:?}: darker than the truth by over {GROSS_ERROR}: {m:?}");
     }
     finish(e);
 }

@@ -492,9 +492,9 @@ Corner shadow_corner(Silhouette s, uint i, int k) {
         return NO_CORNER;
     }
     Corner c = lines_corner(normal, next_normal, vec2(long_stray, next_stray), at, bend);
-    // The short edge's line, through both vertices, its normal outward as the edge's own.
-    if (c.turn != 0.0 && q != p) {
-        vec2 cut = run_normal(normalize(q - p), own_short ? n1 : n2);
+    // The short edge's line, through both vertices: its outward normal.
+    if (c.turn != 0.0) {
+        vec2 cut = own_short ? n1 : n2;
         c.chamfer = vec3(cut, dot(cut, at - p));
     }
     return c;

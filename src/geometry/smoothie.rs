@@ -848,19 +848,21 @@ impl<'a> Outline<'a> {
     /// The outline from `start`'s vertex along its edge to the first vertex at least `length`
     /// away ([`Run`]); none where the walk ends first.
     fn run(&self, start: &'a End, length: f32) -> Option<Run> {
-        let end = self.walk(start).find(|e| e.p.distance(start.p) >= length)?;
+        // The vertices passed, whose edges' turns are measured once the chord is known.
+        let mut passed = [start.p; MAX_WALK + 1];
+        let mut count = 1;
+        let end = self.walk(start).find(|e| {
+            passed[count] = e.p;
+            count += 1;
+            e.p.distance(start.p) >= length
+        })?;
         let chord = (end.p - start.p) / end.p.distance(start.p);
-        let (mut from, mut stray) = (start.p, 0.0_f32);
-        for e in self.walk(start) {
-            let d = (e.p - from) / e.p.distance(from);
+        let turn = |w: &[Vec2]| {
+            let d = (w[1] - w[0]) / w[1].distance(w[0]);
             // An edge that runs back along the chord turns from it the most.
-            stray = stray.max(if chord.dot(d) > 0.0 { chord.perp_dot(d).abs() } else { 1.0 });
-            from = e.p;
-            if e.id == end.id {
-                break;
-            }
-        }
-        Some(Run { chord, stray })
+            if chord.dot(d) > 0.0 { chord.perp_dot(d).abs() } else { 1.0 }
+        };
+        Some(Run { chord, stray: passed[..count].windows(2).map(turn).fold(0.0, f32::max) })
     }
 }
 
@@ -918,9 +920,8 @@ fn shadow_corner(
     if !(near(group[0].p) && near(next.p)) {
         return None;
     }
-    // The short edge's line, through both vertices, its normal outward as the edge's own.
-    let cut = (next.p - group[0].p).try_normalize().map(Vec2::perp).zip(short.side);
-    let chamfer = cut.map(|(m, (_, n))| if m.dot(n) < 0.0 { -m } else { m }).map(|m| (m, m.dot(at - group[0].p)));
+    // The short edge's line, through both vertices: its outward normal.
+    let chamfer = short.side.map(|(_, m)| (m, m.dot(at - group[0].p)));
     corner([(long.0, &long.1), (next_normal, &next_run)], at).map(|c| ShadowCorner { chamfer, ..c })
 }
 
