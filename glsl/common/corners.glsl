@@ -92,16 +92,12 @@ bool footprint_line(mat2 axes, vec2 n, vec2 p, out vec3 line) {
 // shadow is both inner sides, V = 1 − the disk in both; at a reflex one, either, and V the disk
 // in both outer sides, the same lines mirrored. One disk_in_both for either turn: llvmpipe runs
 // both arms of a choice it cannot fold, and a call in each arm cost every corner fragment two.
-// `delta`: other's normal's angle from one's (corner_angle; mirrored alike), which a caller whose
-// lines keep their directions across a primitive finds once per vertex.
+// `delta`: other's normal's angle from one's (corner_angle; mirrored alike), which both callers
+// find once per vertex, their lines keeping their directions across a primitive.
 float corner_v_turned(vec3 one, vec3 other, bool convex, float delta) {
     float s = convex ? 1.0 : -1.0;
     float inside = disk_in_both(s * one.xy, s * one.z, s * other.xy, s * other.z, delta);
     return convex ? 1.0 - inside : inside;
-}
-
-float corner_v(vec3 one, vec3 other, bool convex) {
-    return corner_v_turned(one, other, convex, corner_angle(one.xy, other.xy));
 }
 
 #endif

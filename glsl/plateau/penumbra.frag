@@ -47,6 +47,7 @@ layout(location = 8) flat in vec4 in_axes0;
 layout(location = 9) flat in vec4 in_corner1;
 layout(location = 10) flat in vec4 in_axes1;
 layout(location = 11) flat in vec4 in_turns;
+layout(location = 12) flat in vec2 in_angles;
 // The plateau parameter, signed (−1 .. 1: centred corners write below 0, corners.glsl) and
 // stored as ½ + ½·t in the unsigned texture; the resolve reads it back.
 layout(location = 0) out vec2 out_t;
@@ -128,7 +129,8 @@ float sheet_corner_gain(vec2 from_a, vec2 own) {
     if (!footprint_line(axes, own, p, mine) || !footprint_line(axes, corner.zw, p, other)) {
         return 0.0;
     }
-    return corner_v(mine, other, (first ? in_turns.z : in_turns.w) > 0.5) - disk_below(mine.z);
+    bool convex = (first ? in_turns.z : in_turns.w) > 0.5;
+    return corner_v_turned(mine, other, convex, first ? in_angles.x : in_angles.y) - disk_below(mine.z);
 }
 
 // What the wedge's corner adds to V at y (unit-disk coordinates from the apex, t its cone's),
@@ -145,7 +147,7 @@ float wedge_corner_gain(vec2 y, float t, out float side) {
     bool convex = in_turns.z > 0.5;
     side = (convex ? one.z < 0.0 && other.z < 0.0 : one.z < 0.0 || other.z < 0.0) ? -1.0 : 1.0;
     vec2 rim = t > 0.0 ? y / t - in_shape0.xy : vec2(1.0, 0.0);
-    return corner_v(one, other, convex) - disk_below(side * dot(rim, y));
+    return corner_v_turned(one, other, convex, in_angles.x) - disk_below(side * dot(rim, y));
 }
 
 // The t a centred side writes: its own t on `side` (1 outside the hard edge, −1 inside),

@@ -14,6 +14,7 @@
 #include "interface.glsl"
 #include "mask.glsl"
 #include "probes.glsl"
+#include "corners.glsl"
 
 // As penumbra.frag's.
 layout(constant_id = 0) const bool CENTRED = false;
@@ -52,6 +53,17 @@ layout(location = 8) flat out vec4 out_axes0;
 layout(location = 9) flat out vec4 out_corner1;
 layout(location = 10) flat out vec4 out_axes1;
 layout(location = 11) flat out vec4 out_turns;
+// Centred, per corner: the angle between its two lines in the footprint's disk coordinates
+// (corners.glsl's corner_angle), the same for every fragment of the primitive, whose axes and
+// normals are flat: found here once, not with an atan per corner fragment.
+layout(location = 12) flat out vec2 out_angles;
+
+// The angle from line `one`'s normal to `other`'s as footprint_line makes them under `axes`.
+float footprint_angle(vec4 axes, vec2 one, vec2 other) {
+    mat2 to_disk = transpose(mat2(axes));
+    vec2 g1 = to_disk * one, g2 = to_disk * other;
+    return corner_angle(g1 / max(length(g1), 1e-30), g2 / max(length(g2), 1e-30));
+}
 
 // Whether the hard shadow about a corner at `at` (plane units) is what its two lines (outward
 // normals `one`, `other`) say: the mask PROBE texels out along the four bisectors of the lines,
@@ -101,6 +113,7 @@ void main() {
         out_corner1 = vec4(r5.xy - a, r5.zw);
         out_axes1 = r6;
         out_turns = vec4(r2.xy, float(convex & 1u), float(convex >> 1u & 1u));
+        out_angles = vec2(footprint_angle(r4, r2.xy, r3.zw), footprint_angle(r6, r2.xy, r5.zw));
         if (CORNERS) {
             // Zero normals: no corner (corners.glsl's footprint_line).
             out_corner0.zw *= float(corner_holds(r3.xy, r2.xy, r3.zw, out_turns.z > 0.5));
@@ -133,6 +146,7 @@ void main() {
         out_corner1 = vec4(0.0, 0.0, r3.zw);
         out_axes1 = r1;
         out_turns = vec4(0.0, 0.0, r2.w, r2.w);
+        out_angles = vec2(footprint_angle(r1, r3.xy, r3.zw));
         if (CORNERS && !corner_holds(apex, r3.xy, r3.zw, r2.w > 0.5)) {
             out_corner0.zw = vec2(0.0);
         }
