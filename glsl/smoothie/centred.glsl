@@ -15,6 +15,8 @@ layout(constant_id = 0) const bool INNER = false;
 // reason; and whether it holds chamfered ones (corner_visibility), whose three lines cost more.
 layout(constant_id = 1) const bool CORNERS = false;
 layout(constant_id = 2) const bool CHAMFER = false;
+// The map's texels are the buffer's (equal sizes over one frustum), as the resolve's SAME_GRID.
+layout(constant_id = 3) const bool SAME_GRID = true;
 
 // What an inner quad with α < 1 leaves in the outer smoothies' depth channel, where the
 // resolve's mask draw finds every smoothie with one gather (resolve.frag's near_smoothie): the
@@ -150,6 +152,16 @@ bool centred_fragment(out Centred c) {
         // box's shadow on the lower one's top a hard inner edge (two_boxes' penumbra RMSE 0.103;
         // 0.049 with the limit).
         bool own = caster >= in_range.x - slack && caster <= in_range.y + slack;
+        if (!SAME_GRID) {
+            // The map texel under the centre (map_at) lies up to half a map texel off it, so
+            // near the hard edge it can miss the caster where the centre lies inside its
+            // outline, as the quad says; one of the four map texels about the centre lies on
+            // its side of the edge. Kept so, an inner quad tells the resolve that its texel is
+            // inside the outline (resolve.frag's centred_test).
+            vec4 around = textureGather(shadow_map, uv, 0);
+            vec4 above = vec4(greaterThanEqual(around, vec4(in_range.x - slack)));
+            own = dot(above, vec4(lessThanEqual(around, vec4(in_range.y + slack)))) > 0.0;
+        }
         float outside = map_at(in_probe);
         c.limit = depth_code(light, outside);
         if (CORNERS && corner_open(in_range.y + slack)) {

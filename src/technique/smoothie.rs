@@ -444,8 +444,9 @@ struct CasterSilhouette {
 
 pub struct Smoothie {
     pass: ShadowMapPass,
-    /// The smoothie pass, by what its buffer holds and which smoothies a draw holds.
-    smoothie: Variants<(Buffer, Part)>,
+    /// The smoothie pass, by what its buffer holds, which smoothies a draw holds and whether
+    /// map and buffer share one grid (centred only; the paper's buffer reads no map texels).
+    smoothie: Variants<(Buffer, Part, bool)>,
     /// The smoothie buffer's formats, by [`Buffer`] (in the order of [`Buffer::ALL`]).
     buffer_formats: [Vec<vk::Format>; 3],
     resolve: MaskedResolve,
@@ -699,12 +700,14 @@ impl Technique for Smoothie {
             ensure(ctx, target, TargetDesc::color(name, format, buffer_size, buffer_size))?;
         }
         let draws = source.draws(layout.centred());
-        let make = |&(layout, part): &(Buffer, Part)| {
+        let same_grid = !layout.centred() || buffer_size == size;
+        let make = |&(layout, part, same_grid): &(Buffer, Part, bool)| {
             let constants = if layout.centred() {
                 vec![
                     ("INNER", u32::from(part.inner)),
                     ("CORNERS", u32::from(part.corners)),
                     ("CHAMFER", u32::from(part.chamfer)),
+                    ("SAME_GRID", u32::from(same_grid)),
                 ]
             } else {
                 Vec::new()
@@ -718,7 +721,7 @@ impl Technique for Smoothie {
         };
         // Made before anything is recorded, so that a failure leaves no pass half recorded.
         for &(part, _) in &draws {
-            self.smoothie.get((layout, part), make)?;
+            self.smoothie.get((layout, part, same_grid), make)?;
         }
         let cmd = frame.cmd;
         let (map, light) = self.pass.inputs(frame.slot);
@@ -732,7 +735,7 @@ impl Technique for Smoothie {
         let clears: Vec<_> = targets.iter().flatten().map(|t| Attachment::clear_color(t, [1.0; 4])).collect();
         let pass = RenderPass::begin(ctx, cmd, &clears, None);
         for (part, draw) in draws {
-            let smoothie = self.smoothie.get((layout, part), make)?;
+            let smoothie = self.smoothie.get((layout, part, same_grid), make)?;
             smoothie.bind(ctx, cmd, &[Descriptor::Buffer(light), Descriptor::Image(map)])?;
             match draw {
                 Draw::Vertices { vertices, first, count } => draw_vertices(ctx, cmd, vertices, first, count),
