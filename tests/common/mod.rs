@@ -70,17 +70,18 @@ pub fn largest_difference(a: &Capture, b: &Capture) -> f32 {
     a.visibility.iter().zip(&b.visibility).map(|(x, y)| (v(x) - v(y)).abs()).fold(0.0, f32::max)
 }
 
-/// A coarser grid (`coarse`, named `what`) is as close to `truth` as the finer one: penumbra
-/// RMSE within 0.002 and no more leaks.
-pub fn as_accurate_on_fewer_texels(coarse: &Capture, fine: &Capture, truth: &Capture, what: &str) {
-    let [coarse, fine] = [coarse, fine].map(|v| softshadow::measure::Metrics::between(v, truth).unwrap());
+/// `candidate` (named `what`) is as close to `truth` as `against`: penumbra RMSE within 0.002
+/// and no more leaks. A coarser grid against a finer one, or a setting against the grid it
+/// should match.
+pub fn as_accurate_as(candidate: &Capture, against: &Capture, truth: &Capture, what: &str) {
+    let [candidate, against] = [candidate, against].map(|v| softshadow::measure::Metrics::between(v, truth).unwrap());
     assert!(
-        coarse.penumbra_rmse <= fine.penumbra_rmse + 0.002,
-        "{what}: penumbra RMSE {} on the coarser grid, {} on the finer",
-        coarse.penumbra_rmse,
-        fine.penumbra_rmse
+        candidate.penumbra_rmse <= against.penumbra_rmse + 0.002,
+        "{what}: penumbra RMSE {}, against {}",
+        candidate.penumbra_rmse,
+        against.penumbra_rmse
     );
-    assert!(coarse.leak_rate <= fine.leak_rate, "{what}: leaks {} vs {}", coarse.leak_rate, fine.leak_rate);
+    assert!(candidate.leak_rate <= against.leak_rate, "{what}: leaks {} vs {}", candidate.leak_rate, against.leak_rate);
 }
 
 /// The ground truth the accuracy bounds are stated against: the GPU reference with 256 light
