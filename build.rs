@@ -3,13 +3,17 @@
 //!
 //! `glsl/prepass/scene.vert` becomes `PREPASS_SCENE_VERT`, and `ALL` lists them all.
 //! `#include "x.glsl"` resolves next to the including file first, then in `glsl/common/`. A GLSL
-//! error fails the build with the shader's path, line and the compiler's message.
+//! error fails the build with the shader's path, line and the compiler's message. Every shader
+//! sees the constants of `src/shader_constants.rs` as macros ([`shared_constants`]).
 
 // Linked for its side effect: the glslang archives Debian's libshaderc needs.
 use shaderc_link as _;
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};
+
+#[path = "src/shader_constants.rs"]
+mod shader_constants;
 
 const STAGES: [(&str, shaderc::ShaderKind); 3] = [
     ("vert", shaderc::ShaderKind::Vertex),
@@ -22,6 +26,8 @@ fn main() {
     let glsl = root.join("glsl");
     let common = glsl.join("common");
     println!("cargo:rerun-if-changed={}", glsl.display());
+    println!("cargo:rerun-if-changed={}", root.join("src/shader_constants.rs").display());
+    let shared = shared_constants();
 
     let mut files = Vec::new();
     collect(&glsl, &mut files);
@@ -43,6 +49,9 @@ fn main() {
         options.set_optimization_level(shaderc::OptimizationLevel::Performance);
         options.set_generate_debug_info();
         options.set_warnings_as_errors();
+        for (name, value) in &shared {
+            options.add_macro_definition(name, Some(value));
+        }
         let common = common.clone();
         options.set_include_callback(move |name, _ty, includer, _depth| {
             let beside = Path::new(includer).parent().map(|d| d.join(name));
@@ -82,6 +91,71 @@ fn main() {
     writeln!(generated, "/// Every shader above.\npub static ALL: &[&Shader] = &[{list}];").unwrap();
     let out = PathBuf::from(std::env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("shaders.rs");
     fs::write(&out, generated).unwrap_or_else(|e| panic!("{}: {e}", out.display()));
+}
+
+/// Every constant of `src/shader_constants.rs` as a GLSL macro's name and value. One left out
+/// here is unused in this build script, which warns.
+fn shared_constants() -> Vec<(&'static str, String)> {
+    use shader_constants::*;
+    macro_rules! glsl {
+        ($($name:ident),* $(,)?) => { vec![$((stringify!($name), Glsl::glsl($name))),*] };
+    }
+    glsl![
+        COMPUTE_GROUP,
+        NO_FACE,
+        SMOOTHIE_VERTEX_FLOATS,
+        MIN_DEPTH,
+        KEEP_ALL,
+        CUT_MARGIN,
+        SLIVER,
+        KEEP_SLACK,
+        MAX_WALK,
+        RUN_STRAY,
+        STAGE_PAIR,
+        STAGE_OWN,
+        STAGE_DRAW,
+        CORNER_WORDS,
+        STAMP_WORDS,
+        VOLUME_VERTEX_FLOATS,
+        WEDGE_VEC4S,
+        SHEET_VEC4S,
+        SHEET_SAMPLES,
+        MASK_PROBE,
+        SHEET_SLACK,
+        FOLD_SLACK,
+    ]
+}
+
+/// A Rust constant as a GLSL literal of the type the shaders use it as.
+trait Glsl {
+    fn glsl(self) -> String;
+}
+
+impl Glsl for usize {
+    fn glsl(self) -> String {
+        i32::try_from(self).expect("a shared usize constant fits a GLSL int").to_string()
+    }
+}
+
+impl Glsl for u32 {
+    fn glsl(self) -> String {
+        format!("{self}u")
+    }
+}
+
+impl Glsl for f32 {
+    fn glsl(self) -> String {
+        assert!(self.is_finite(), "a shared float constant is finite");
+        // Debug prints the shortest decimal that reads back as the same f32, always with a
+        // point or an exponent, so GLSL reads a float.
+        format!("({self:?})")
+    }
+}
+
+impl Glsl for [f32; 2] {
+    fn glsl(self) -> String {
+        format!("vec2({}, {})", self[0].glsl(), self[1].glsl())
+    }
 }
 
 fn collect(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -27,6 +27,7 @@ pub mod measure;
 pub mod reference;
 pub mod renderer;
 pub mod scene;
+mod shader_constants;
 pub mod technique;
 
 pub use error::{Error, Result};

@@ -5,8 +5,7 @@
 
 layout(set = 0, binding = 1) uniform sampler2D mask;
 
-// How far off the foot the mask is probed, in texels: past the hard edge's rasterisation.
-const float PROBE = 2.0;
+// How far off the foot the mask is probed: MASK_PROBE texels (src/shader_constants.rs).
 
 uint caster_at(vec2 texel) {
     ivec2 size = textureSize(mask, 0);

@@ -56,10 +56,9 @@ float cross2(vec2 a, vec2 b) {
     return a.x * b.y - a.y * b.x;
 }
 
-// Slack of s and t at a sheet's sides (f32 rounding), and how near, relative to the patch's
-// size, a root near a fold line must map back, as geometry::plateau::Sheet::at.
-const float SHEET_SLACK = 1e-4;
-const float FOLD_SLACK = 1e-4;
+// SHEET_SLACK and FOLD_SLACK (src/shader_constants.rs): slack of s and t at a sheet's sides
+// (f32 rounding), and how near, relative to the patch's size, a root near a fold line must map
+// back, as geometry::plateau::Sheet::at.
 
 // A sheet's smallest t over this fragment and its foot's s on the hard edge: the inverse of the
 // bilinear map q = s·e + t·f + s·t·g (q = p − a), whose t solves (f × g)·t² + (f × e − q × g)·t −
@@ -196,7 +195,7 @@ bool centred_t(float t, float s, out vec2 written) {
         if (dot(from_foot, from_foot) < 1e-8) {
             return false; // on the apex itself: the sheets meeting there write it
         }
-        vec2 probe = PROBE * normalize(from_foot);
+        vec2 probe = MASK_PROBE * normalize(from_foot);
         uint a = caster_at(foot + probe), b = caster_at(foot - probe);
         boundary = a == 0u || b == 0u;
         own_both = a == in_caster && b == in_caster;

@@ -66,7 +66,7 @@ float footprint_angle(vec4 axes, vec2 one, vec2 other) {
 }
 
 // Whether the hard shadow about a corner at `at` (plane units) is what its two lines (outward
-// normals `one`, `other`) say: the mask PROBE texels out along the four bisectors of the lines,
+// normals `one`, `other`) say: the mask MASK_PROBE texels out along the four bisectors of the lines,
 // shadow in only the one inside both (convex) or in all but the one outside both (reflex). Not
 // where the other edge is an interior fold (the cow's legs against its body) or lies off the
 // boundary, or where a spike is too thin for the mask to show: no corner there. Unchecked,
@@ -80,7 +80,7 @@ bool corner_holds(vec2 at, vec2 one, vec2 other, bool convex) {
     bool holds = true;
     for (int k = 0; k < 4; k++) {
         vec2 d = bisectors[k] * to_texels;
-        bool shadow = caster_at(centre + PROBE * d / max(length(d), 1e-30)) != 0u;
+        bool shadow = caster_at(centre + MASK_PROBE * d / max(length(d), 1e-30)) != 0u;
         // k = 0 inside both, 1 outside both, 2 and 3 inside one.
         holds = holds && shadow == (k == 0 || !convex && k != 1);
     }

@@ -1,6 +1,6 @@
 #version 460
 // Centred, where each sheet's foot lies on the hard shadow's boundary (penumbra.frag writes a
-// sheet's t only there): the umbra mask probed PROBE texels either side of its hard edge, at
+// sheet's t only there): the umbra mask probed MASK_PROBE texels either side of its hard edge, at
 // the middles of pieces at most a texel long (the CPU cuts sheets into pieces short enough),
 // once per sheet. Probed per fragment, two mask reads each cost the centred sheets on lavapipe
 // more than their roots did; per sheet vertex, six times over, the long edges of a few large
@@ -9,7 +9,7 @@
 #include "mask.glsl"
 #include "probes.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = COMPUTE_GROUP) in;
 
 // As penumbra.frag's: more than one caster, so a sheet may write over another's hard shadow.
 layout(constant_id = 1) const bool OVERLAPS = true;
@@ -34,9 +34,9 @@ void main() {
     // In texels, as penumbra.frag finds the foot: a + s·(b − a).
     vec2 to_texels = vec2(textureSize(mask, 0)) / (plateau.window.zw - plateau.window.xy);
     vec2 a = (r0.xy - plateau.window.xy) * to_texels, edge = (r0.zw - r0.xy) * to_texels;
-    vec2 probe = PROBE * normalize(r2.xy * to_texels);
+    vec2 probe = MASK_PROBE * normalize(r2.xy * to_texels);
     uint caster = uint(r2.z);
-    uint n = clamp(uint(ceil(length(edge))), 1u, SAMPLES);
+    uint n = clamp(uint(ceil(length(edge))), 1u, SHEET_SAMPLES);
     uvec4 bits = uvec4(0u);
     for (uint k = 0u; k < n; k++) {
         vec2 foot = a + edge * ((float(k) + 0.5) / float(n));

@@ -3,13 +3,9 @@
 #ifndef SOFTSHADOW_PLATEAU_PROBES_GLSL
 #define SOFTSHADOW_PLATEAU_PROBES_GLSL
 
-// The sides' records (geometry::plateau::Wedge, Sheet), in vec4s.
-const uint WEDGE_VEC4S = 4u;
-const uint SHEET_VEC4S = 7u;
-
-// Most samples a sheet's probes hold (a bit each in each half of `bits`): the CPU cuts longer
-// sheets into pieces, for a sample every texel.
-const uint SAMPLES = 64u;
+// The sides' records (geometry::plateau::Wedge, Sheet) are WEDGE_VEC4S and SHEET_VEC4S vec4s;
+// a sheet's probes hold SHEET_SAMPLES samples at most (a bit each in each half of `bits`), the
+// CPU cutting longer sheets into pieces, for a sample every texel (src/shader_constants.rs).
 
 // A centred sheet's probes of the mask along its hard edge (probes.comp): per sample, the
 // middles of `samples.x` equal pieces from a to b, whether the mask is lit on either side of

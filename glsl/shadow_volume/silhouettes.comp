@@ -6,10 +6,7 @@
 // indirect draws. The vertices are the CPU path's: object-space position, at infinity, object.
 #include "interface.glsl"
 
-layout(local_size_x = 64) in;
-
-const uint NO_FACE = 0xffffffffu;
-const uint FLOATS = 5u;
+layout(local_size_x = COMPUTE_GROUP) in;
 
 layout(set = 0, binding = 0) uniform Params { VolumeParams params; };
 // Positions (float bits), then triangles, then edges (v0, v1, face0, face1), then face planes
@@ -43,11 +40,11 @@ uint reserve(uint command, uint end, uint n) {
 
 void put(uint at, uint vertex, bool far) {
     vec3 p = object_position(vertex);
-    vertices[FLOATS * at + 0u] = p.x;
-    vertices[FLOATS * at + 1u] = p.y;
-    vertices[FLOATS * at + 2u] = p.z;
-    vertices[FLOATS * at + 3u] = far ? 1.0 : 0.0;
-    vertices[FLOATS * at + 4u] = float(params.counts.w);
+    vertices[VOLUME_VERTEX_FLOATS * at + 0u] = p.x;
+    vertices[VOLUME_VERTEX_FLOATS * at + 1u] = p.y;
+    vertices[VOLUME_VERTEX_FLOATS * at + 2u] = p.z;
+    vertices[VOLUME_VERTEX_FLOATS * at + 3u] = far ? 1.0 : 0.0;
+    vertices[VOLUME_VERTEX_FLOATS * at + 4u] = float(params.counts.w);
 }
 
 void edge(uint i) {

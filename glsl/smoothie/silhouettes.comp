@@ -5,10 +5,9 @@
 #extension GL_EXT_control_flow_attributes : require
 #include "interface.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = COMPUTE_GROUP) in;
 
-const uint NO_FACE = 0xffffffffu;
-const float MIN_DEPTH = 1e-6;
+// NO_FACE, MIN_DEPTH and the construction's other constants are src/shader_constants.rs's.
 
 // Smoothie size from the light's angular radius at the blocker (t = scale · R / b), or fixed.
 layout(constant_id = 0) const bool PHYSICAL_SIZE = true;
@@ -25,17 +24,8 @@ layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
 struct Draw { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
 layout(std430, set = 0, binding = 5) buffer Args { Draw draws[4]; };
 // x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel, cx, cy, normals, turn, along, keep, chamfer
-// (src/geometry/smoothie.rs's SmoothieVertex)
+// (src/geometry/smoothie.rs's SmoothieVertex, SMOOTHIE_VERTEX_FLOATS of them)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
-const uint FLOATS = 26u;
-// What a smoothie that is no piece of a cut quad keeps (src/geometry/smoothie.rs's KEEP_ALL).
-const vec2 KEEP_ALL = vec2(-3.40282347e38, 3.40282347e38);
-// How far a piece of a cut quad reaches past its cuts, in smoothie widths (CUT_MARGIN there).
-const float CUT_MARGIN = 0.25;
-// How far a cut quad's sliver over its base reaches from it (SLIVER there).
-const float SLIVER = 0.125;
-// How much of each other's part two pieces keep at their cut (KEEP_SLACK there).
-const float KEEP_SLACK = 1e-4;
 
 vec3 view_position(uint v) {
     return (params.model_view * vec4(positions[v].xyz, 1.0)).xyz;
@@ -116,8 +106,8 @@ void put(uint at, Vertex v, Inner inner, Corner c, vec2 keep) {
                             inner.normal.y, inner.range.x, inner.range.y, v.w, params.light.y, c.at.x, c.at.y,
                             c.normals.x, c.normals.y, c.normals.z, c.normals.w, c.turn, v.along, keep.x, keep.y,
                             c.chamfer.x, c.chamfer.y, c.chamfer.z);
-    for (uint k = 0u; k < FLOATS; k++) {
-        vertices[FLOATS * at + k] = f[k];
+    for (uint k = 0u; k < SMOOTHIE_VERTEX_FLOATS; k++) {
+        vertices[SMOOTHIE_VERTEX_FLOATS * at + k] = f[k];
     }
 }
 
@@ -232,34 +222,30 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
 }
 
 // Three dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex and finds
-// each vertex's own corner once: PAIR counts each silhouette vertex's edge ends (stamped, so no
-// clear is needed) and keeps the first two; OWN has each vertex's first end find the hard
-// shadow's corner there (centred); then DRAW, where each vertex's first end draws its corner, a
+// each vertex's own corner once: STAGE_PAIR counts each silhouette vertex's edge ends (stamped, so no
+// clear is needed) and keeps the first two; STAGE_OWN has each vertex's first end find the hard
+// shadow's corner there (centred); then STAGE_DRAW, where each vertex's first end draws its corner, a
 // wedge from both ends' sides where exactly two meet, else a full square, and each edge its
-// quads, carrying the corners near its ends. Found in DRAW, each vertex's own corner would be
+// quads, carrying the corners near its ends. Found in STAGE_DRAW, each vertex's own corner would be
 // found again by every search that passed it, each time walking its runs (as the CPU path,
 // which keeps them per vertex, does not).
-const uint PAIR = 0u, OWN = 1u, DRAW = 2u;
-layout(constant_id = 1) const uint STAGE = PAIR;
+layout(constant_id = 1) const uint STAGE = STAGE_PAIR;
 
-// Per vertex in `stamps`: the stamped count word, the first two edge ends (PAIR), and the own
-// corner's at, normals, turn and chamfer as float bits (OWN), CORNER_WORDS of them. The stamps
-// buffer is sized from WORDS, which smoothie_gpu.rs sets (STAMP_WORDS).
-const uint CORNER_WORDS = 10u;
-layout(constant_id = 2) const uint WORDS = 13u;
-
+// Per vertex in `stamps`, STAMP_WORDS: the stamped count word, the first two edge ends
+// (STAGE_PAIR), and the own corner's at, normals, turn and chamfer as float bits (STAGE_OWN),
+// CORNER_WORDS of them.
 void store_corner(uint v, Corner c) {
     float f[CORNER_WORDS] = float[CORNER_WORDS](c.at.x, c.at.y, c.normals.x, c.normals.y, c.normals.z, c.normals.w,
                                                 c.turn, c.chamfer.x, c.chamfer.y, c.chamfer.z);
     for (uint k = 0u; k < CORNER_WORDS; k++) {
-        stamps[WORDS * v + 3u + k] = floatBitsToUint(f[k]);
+        stamps[STAMP_WORDS * v + 3u + k] = floatBitsToUint(f[k]);
     }
 }
 
 Corner own_corner(uint v) {
     float f[CORNER_WORDS];
     for (uint k = 0u; k < CORNER_WORDS; k++) {
-        f[k] = uintBitsToFloat(stamps[WORDS * v + 3u + k]);
+        f[k] = uintBitsToFloat(stamps[STAMP_WORDS * v + 3u + k]);
     }
     return Corner(vec2(f[0], f[1]), vec4(f[2], f[3], f[4], f[5]), f[6], vec3(f[7], f[8], f[9]));
 }
@@ -301,10 +287,10 @@ bool silhouette(uint i, out Silhouette s) {
 // The stamped count word of vertex v: this frame's count in the low two bits (saturating).
 uint arrive(uint v) {
     uint stamp = params.counts.y << 2u;
-    uint old = stamps[WORDS * v];
+    uint old = stamps[STAMP_WORDS * v];
     for (;;) {
         uint n = (old & ~3u) == stamp ? old & 3u : 0u;
-        uint seen = atomicCompSwap(stamps[WORDS * v], old, stamp | min(n + 1u, 3u));
+        uint seen = atomicCompSwap(stamps[STAMP_WORDS * v], old, stamp | min(n + 1u, 3u));
         if (seen == old) {
             return n;
         }
@@ -361,16 +347,12 @@ bool turn_at(Silhouette s, int k, uint count, uint other, out vec2 n1, out vec2 
 
 // The vertex's other end beside end k of edge i.
 uint other_end(uint i, int k, uint v) {
-    uint first = stamps[WORDS * v + 1u];
-    return first == 2u * i + uint(k) ? stamps[WORDS * v + 2u] : first;
+    uint first = stamps[STAMP_WORDS * v + 1u];
+    return first == 2u * i + uint(k) ? stamps[STAMP_WORDS * v + 2u] : first;
 }
 
 // No end: where the outline stops at a vertex without exactly two ends.
 const uint NO_END = 0xffffffffu;
-// The most vertices a walk along the outline passes, and how far a run's edges may turn from its
-// chord, over the corner's turn (src/geometry/smoothie.rs's MAX_WALK, RUN_STRAY).
-const int MAX_WALK = 32;
-const float RUN_STRAY = 1.0 / 16.0;
 
 // One step of the outline from the end `code` (2 · edge + end) leaving its vertex: the vertex it
 // arrives at, its point, and the end leaving that onward, NO_END where it has not exactly two
@@ -380,12 +362,14 @@ void walk(inout uint code, out uint vertex, out vec2 p) {
     vertex = k == 0u ? edges[e].y : edges[e].x;
     vec3 q = view_position(vertex);
     p = q.xy / q.z;
-    code = (stamps[WORDS * vertex] & 3u) == 2u ? other_end(e, int(1u - k), vertex) : NO_END;
+    code = (stamps[STAMP_WORDS * vertex] & 3u) == 2u ? other_end(e, int(1u - k), vertex) : NO_END;
 }
 
 // The outline from p0 along the end `code` to the first vertex at least `length` away: its
 // chord, and how far its edges turn from it (the largest sine; 1 where one runs back); false
-// where the walk ends first (src/geometry/smoothie.rs's Outline::run).
+// where the walk ends first (src/geometry/smoothie.rs's Outline::run). It walks twice, as the
+// chord is known only at the walk's end: the CPU path keeps the points it passed instead, which
+// here would hold MAX_WALK + 1 of them in every invocation (local memory on a GPU).
 bool run(uint code, vec2 p0, float length, out vec2 chord, out float stray) {
     uint c = code, vertex;
     vec2 p;
@@ -438,7 +422,7 @@ Corner shadow_corner(Silhouette s, uint i, int k) {
     uint other = other_end(i, k, v);
     vec2 n1, n2, m;
     float bend;
-    if (params.counts.w == 0u || !turn_at(s, k, stamps[WORDS * v] & 3u, other, n1, n2, m, bend)) {
+    if (params.counts.w == 0u || !turn_at(s, k, stamps[STAMP_WORDS * v] & 3u, other, n1, n2, m, bend)) {
         return NO_CORNER;
     }
     float t, kk;
@@ -479,7 +463,7 @@ Corner shadow_corner(Silhouette s, uint i, int k) {
     vec2 next_chord;
     float next_stray;
     vec2 q = short_edge.t[far_end];
-    if (!turn_at(short_edge, far_end, stamps[WORDS * far] & 3u, next, f1, next_normal, fm, far_bend) ||
+    if (!turn_at(short_edge, far_end, stamps[STAMP_WORDS * far] & 3u, next, f1, next_normal, fm, far_bend) ||
         far_bend * bend <= 0.0 || !run(next, q, radius, next_chord, next_stray)) {
         return NO_CORNER;
     }
@@ -514,7 +498,7 @@ bool holds(Corner c, vec2 p) {
 Corner carried_corner(Silhouette s, uint i, int k) {
     uint v = s.v[k];
     Corner own = own_corner(v);
-    if (own.turn != 0.0 || (stamps[WORDS * v] & 3u) != 2u) {
+    if (own.turn != 0.0 || (stamps[STAMP_WORDS * v] & 3u) != 2u) {
         return own;
     }
     vec2 p = s.t[k];
@@ -671,24 +655,24 @@ void main() {
     }
     Silhouette s;
     if (!silhouette(i, s)) {
-        if (STAGE == DRAW) {
+        if (STAGE == STAGE_DRAW) {
             partial_silhouette(i);
         }
         return;
     }
-    if (STAGE == PAIR) {
+    if (STAGE == STAGE_PAIR) {
         for (uint k = 0u; k < 2u; k++) {
             uint n = arrive(s.v[k]);
             if (n < 2u) {
-                stamps[WORDS * s.v[k] + 1u + n] = 2u * i + k;
+                stamps[STAMP_WORDS * s.v[k] + 1u + n] = 2u * i + k;
             }
         }
         return;
     }
     // In loops kept rolled: each call is inlined, and llvmpipe's compile time grows with them.
-    if (STAGE == OWN) {
+    if (STAGE == STAGE_OWN) {
         [[dont_unroll]] for (int k = 0; k < 2; k++) {
-            if (stamps[WORDS * s.v[k] + 1u] == 2u * i + uint(k)) {
+            if (stamps[STAMP_WORDS * s.v[k] + 1u] == 2u * i + uint(k)) {
                 store_corner(s.v[k], shadow_corner(s, i, k));
             }
         }
@@ -700,8 +684,8 @@ void main() {
     }
     for (int k = 0; k < 2; k++) {
         uint v = s.v[k];
-        if (stamps[WORDS * v + 1u] == 2u * i + uint(k)) {
-            corner(s, k, stamps[WORDS * v] & 3u, stamps[WORDS * v + 2u], corners[k]);
+        if (stamps[STAMP_WORDS * v + 1u] == 2u * i + uint(k)) {
+            corner(s, k, stamps[STAMP_WORDS * v] & 3u, stamps[STAMP_WORDS * v + 2u], corners[k]);
         }
     }
     if (!s.sided) {

@@ -6,8 +6,7 @@
 
 use std::collections::HashMap;
 
-/// Marks the missing second face of a boundary edge.
-pub const NO_FACE: u32 = u32::MAX;
+pub use crate::shader_constants::NO_FACE;
 
 /// One edge, its vertices in the winding order of `faces[0]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

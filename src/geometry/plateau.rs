@@ -22,6 +22,8 @@ use std::f32::consts::TAU;
 
 use rayon::prelude::*;
 
+use crate::shader_constants::{FOLD_SLACK, SHEET_SLACK, SHEET_VEC4S, WEDGE_VEC4S};
+
 use super::silhouette::{
     Caster, EdgeSource, FacePlanes, Facing, PARTIAL_GAIN, PartialEdge, partial_silhouettes, penumbra_edges,
 };
@@ -309,16 +311,9 @@ pub struct Corner {
 /// corner 1 (at b), where it is the intersection of the two edges' inner sides, not their union.
 pub const CONVEX_BITS: u32 = 3 << 12;
 
-// The records' sizes as glsl/plateau/probes.glsl reads them (WEDGE_VEC4S, SHEET_VEC4S).
-const _: () = assert!(size_of::<Sheet>() == 7 * 16 && size_of::<Wedge>() == 4 * 16);
-
-/// Slack of the inverse map's s and t at the patch's sides (f32 rounding): a fragment on a side
-/// shared with a neighbour is drawn by both rather than by neither.
-const SHEET_SLACK: f32 = 1e-4;
-/// How near p, relative to the patch's size (the root of its sides' summed squares), a root
-/// near a fold line must map back to count (where d rounds below 0, or s swings out of range
-/// with t's rounding).
-const FOLD_SLACK: f32 = 1e-4;
+// The records' sizes as the shaders read them.
+const _: () =
+    assert!(size_of::<Sheet>() == SHEET_VEC4S as usize * 16 && size_of::<Wedge>() == WEDGE_VEC4S as usize * 16);
 
 impl Sheet {
     fn new(a: Vec2, b: Vec2, ta: Vec2, tb: Vec2, normal: Vec2, caster: f32) -> Self {

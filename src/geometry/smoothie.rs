@@ -41,9 +41,8 @@ use super::Aabb;
 use super::chains::{self, MergedEdge, PenumbraEdge};
 use super::plateau::MIN_TURN;
 use super::silhouette::{Caster, EdgeSource, FacePlanes, PARTIAL_GAIN, PartialEdge, penumbra_edges};
-
-/// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
-const MIN_DEPTH: f32 = 1e-6;
+pub use crate::shader_constants::KEEP_ALL;
+use crate::shader_constants::{CUT_MARGIN, KEEP_SLACK, MAX_WALK, MIN_DEPTH, RUN_STRAY, SLIVER, SMOOTHIE_VERTEX_FLOATS};
 
 /// One smoothie vertex.
 #[repr(C)]
@@ -96,8 +95,8 @@ pub struct SmoothieVertex {
     pub chamfer: [f32; 3],
 }
 
-/// What a smoothie that is no piece of a cut quad keeps: everything.
-pub const KEEP_ALL: [f32; 2] = [f32::MIN, f32::MAX];
+// The compute path writes the vertices as floats (glsl/smoothie/silhouettes.comp).
+const _: () = assert!(size_of::<SmoothieVertex>() == SMOOTHIE_VERTEX_FLOATS * 4);
 
 /// A vertex of the hard shadow's outline where two silhouette edges turn (issue 20): near it
 /// the penumbra is the light's footprint cut by both edges' lines. As the plateau's `Corner`
@@ -591,21 +590,6 @@ fn edge_quad(
     }
 }
 
-/// How far, in smoothie widths (the wider rim), a piece of a cut quad reaches past its cuts
-/// ([`edge_quad`]): a quarter, at least a texel where the grid resolves the smoothie (see the
-/// technique's `PENUMBRA_TEXELS`), and far more than the rasterizer's snapping, 1/256 texel.
-const CUT_MARGIN: f32 = 0.25;
-
-/// How far a cut quad's sliver over its base ([`edge_quad`]) reaches from it at its middle, in
-/// its width: a texel or more wherever a piece keeps fragments off the quad's ends.
-const SLIVER: f32 = 0.125;
-
-/// How much of the other's part of the edge each of two pieces keeps at their cut
-/// ([`edge_quad`]): far more than `along`'s rounding, a few 1e-7, and V there is the same from
-/// both to about as little, the corner's difference having vanished at a cut (overlap: a lit
-/// speckle, V 0.78 for 0.50, where neither kept a fragment).
-const KEEP_SLACK: f32 = 1e-4;
-
 /// The vertex `u` of the way from `a` to `b`, two vertices of one quad's side, with what the
 /// rasterizer interpolates there: position, depth, foot and `along` linearly, the shape projectively by
 /// w = 1/t ([`SmoothieVertex::w`]), so a piece of a quad interpolates as the whole did.
@@ -776,20 +760,6 @@ struct Outline<'a> {
     groups: Vec<&'a [End]>,
     group_of: Vec<usize>,
 }
-
-/// The most vertices a walk along the [`Outline`] passes: a run or a search that needs more,
-/// on an outline cut finer than a 32nd of its reach, finds no corner.
-const MAX_WALK: usize = 32;
-
-/// How far the edges of a run of the outline into a corner may turn from its chord ([`Run`]),
-/// as a sine: a 16th of the corner's own turn (radians). A polygon's side passes, straight or
-/// cut into edges that zigzag across it by far less; a tessellated curve, whose edges at the
-/// run's ends turn from any chord by half the chord's own turn, does not, and keeps its edges'
-/// own V, as the reach ([`CORNER_REACH`]) keeps it where its edges are long. Strays measured as
-/// the vertices' distances from the chord let a curve through where its chord ends in one long
-/// edge (a corner on the sphere's outline darkened its shadow on `default`: penumbra RMSE
-/// 0.0963 against 0.0868 with the edges' turns, 512², one run each).
-const RUN_STRAY: f32 = 1.0 / 16.0;
 
 /// The outline from a vertex to the first vertex it passes [`CORNER_REACH`] footprint radii
 /// away or more ([`Outline::run`]): its chord's direction, and how far its edges turn from it

@@ -127,6 +127,7 @@ use crate::gpu::{
     draw_generated, ensure, shaders, transition,
 };
 use crate::scene::Mesh;
+use crate::shader_constants::{COMPUTE_GROUP, MASK_PROBE, SHEET_SAMPLES};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "plateau",
@@ -254,15 +255,8 @@ const PLATEAU_FORMAT: vk::Format = vk::Format::R16G16_UNORM;
 /// The plateau texture with nothing for a second channel to hold: outer only, or one caster.
 /// Half the bytes for every pass that writes or reads it to clear, blend and gather.
 const PLATEAU_FORMAT_ONE: vk::Format = vk::Format::R16_UNORM;
-/// Most samples at which a centred sheet's mask probes are taken along its hard edge, as
-/// `glsl/plateau/probes.glsl`'s SAMPLES (a bit each in 64-bit sets): longer sheets are drawn in
-/// pieces, for a sample every texel.
-const SHEET_SAMPLES: u32 = 64;
-const _: () = assert!(SHEET_SAMPLES <= 64);
 /// One sheet's probes (`SheetProbes`, two uvec4).
 const SHEET_PROBE_BYTES: u64 = 32;
-/// The probes' workgroup size (probes.comp).
-const PROBE_GROUP: u32 = 64;
 /// The umbra mask: each texel the number of the caster whose hard shadow covers it (0: none).
 const MASK_FORMAT: vk::Format = vk::Format::R16_UNORM;
 
@@ -586,7 +580,7 @@ impl Technique for Plateau {
                 Pipeline::compute(ctx, "probes", &shaders::PLATEAU_PROBES_COMP, &constants)
             })?;
             pipeline.bind(ctx, cmd, inputs)?;
-            dispatch(ctx, cmd, view.sheets.y.div_ceil(PROBE_GROUP));
+            dispatch(ctx, cmd, view.sheets.y.div_ceil(COMPUTE_GROUP));
             buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_WRITE, BufferAccess::VERTEX_STORAGE_READ);
             frame.timer.end(ctx, cmd);
         }
@@ -672,9 +666,6 @@ impl Technique for Plateau {
     }
 }
 
-/// How far the mask probes look from a hard edge, in texels (glsl/plateau/mask.glsl's PROBE).
-const MASK_PROBE: f32 = 2.0;
-
 /// Whether two casters' shadows may overlap: their footprints (umbra, cones and sheets: their
 /// shadows' bounds on the plane, unbounded for a caster reaching the light's height) within
 /// `probe` of each other, the distance the mask probes look from a hard edge. Only then do the
@@ -711,14 +702,5 @@ mod tests {
         assert!(!footprints_meet([&unit, &PlateauGeometry::default()].into_iter(), 0.1));
         let unbounded = PlateauGeometry { unbounded: true, ..beside(50.0) };
         assert!(footprints_meet([&unit, &unbounded].into_iter(), 0.1));
-    }
-
-    /// The CPU cuts sheets for as many samples as the shaders' probes hold.
-    #[test]
-    fn sheets_are_cut_for_the_samples_the_probes_hold() {
-        let probes = include_str!("../../glsl/plateau/probes.glsl");
-        assert!(probes.contains(&format!("const uint SAMPLES = {SHEET_SAMPLES}u;")), "SAMPLES differs");
-        let mask = include_str!("../../glsl/plateau/mask.glsl");
-        assert!(mask.contains(&format!("const float PROBE = {MASK_PROBE:.1};")), "PROBE differs");
     }
 }

@@ -68,6 +68,7 @@ use crate::gpu::{
     RenderPass, Target, TargetDesc, VertexInput, draw_fullscreen, draw_vertices, ensure, shaders, transition,
 };
 use crate::scene::{Mesh, MeshId, Object};
+use crate::shader_constants::VOLUME_VERTEX_FLOATS;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "shadow-volume",
@@ -109,8 +110,6 @@ const GPU_SILHOUETTES: Knob = Knob {
 /// The stencil bits that count; the top one marks the pixels an earlier group shadowed.
 const COUNT_MASK: u32 = 0x7F;
 const SHADOWED_BY_A_GROUP: u32 = 0x80;
-/// Floats per volume vertex: object-space position, at infinity (0 or 1), object index.
-const VERTEX_FLOATS: usize = 5;
 /// Orthographic views: how far volumes reach, in multiples of the farthest scene point's
 /// distance from the light (a dark cap's chord stays beyond the scene up to 170° of caster).
 const FINITE_REACH: f32 = 1e3;
@@ -304,11 +303,11 @@ impl ShadowVolumes {
             .flat_map(|(_, v)| v)
             .map(|v| v.sides.len() + v.far_caps.len() + v.near_caps.len() + v.turned_caps.len())
             .sum();
-        let mut out = Vec::with_capacity(3 * VERTEX_FLOATS * triangles);
+        let mut out = Vec::with_capacity(3 * VOLUME_VERTEX_FLOATS * triangles);
         let mut ranges = Vec::with_capacity(points * groups.len());
         for p in 0..points {
             for group in groups {
-                let first = (out.len() / VERTEX_FLOATS) as u32;
+                let first = (out.len() / VOLUME_VERTEX_FLOATS) as u32;
                 let mut counts = [0u32; 3];
                 for (part, count) in counts.iter_mut().enumerate() {
                     let start = out.len();
@@ -329,7 +328,7 @@ impl ShadowVolumes {
                             _ => volume.turned_caps.iter().flatten().for_each(|&v| put(v, false)),
                         }
                     }
-                    *count = ((out.len() - start) / VERTEX_FLOATS) as u32;
+                    *count = ((out.len() - start) / VOLUME_VERTEX_FLOATS) as u32;
                 }
                 ranges.push((first, counts));
             }

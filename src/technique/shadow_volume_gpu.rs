@@ -27,11 +27,11 @@ use crate::gpu::{
     buffer_barrier, copy_buffer, dispatch, draw_indirect, shaders, upload,
 };
 use crate::scene::{Mesh, MeshId};
+use crate::shader_constants::{COMPUTE_GROUP, VOLUME_VERTEX_FLOATS};
 
-const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<VolumeParams>() as u64;
 /// Bytes per volume vertex: position, at infinity, object (as the CPU path's).
-const VERTEX_BYTES: u64 = 20;
+const VERTEX_BYTES: u64 = 4 * VOLUME_VERTEX_FLOATS as u64;
 /// Draws per caster group and point: sides, caps, turned caps.
 pub const PARTS: usize = 3;
 
@@ -254,7 +254,7 @@ impl GpuVolumes {
                 Descriptor::Buffer(vertices),
             ];
             self.pipeline.bind(ctx, cmd, &inputs)?;
-            dispatch(ctx, cmd, mesh.edges.max(mesh.triangles).div_ceil(GROUP));
+            dispatch(ctx, cmd, mesh.edges.max(mesh.triangles).div_ceil(COMPUTE_GROUP));
         }
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::INDIRECT_DRAW);
         Ok(())

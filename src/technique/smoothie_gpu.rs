@@ -27,8 +27,8 @@ use crate::gpu::{
     Uploads, Variants, buffer_barrier, dispatch, shaders, update_buffer, upload,
 };
 use crate::scene::{Mesh, MeshId, Object};
+use crate::shader_constants::{COMPUTE_GROUP, STAGE_DRAW, STAGE_OWN, STAGE_PAIR, STAMP_WORDS};
 
-const GROUP: u32 = 64;
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
@@ -36,17 +36,6 @@ const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::Smoothi
 /// the outer smoothies', away from the hard shadow's corners and near them, then the inner
 /// quads' alike.
 const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
-
-/// Words per vertex in a mesh's stamps buffer: the stamped count, the first two edge ends and the
-/// vertex's own corner (silhouettes.comp's CORNER_WORDS, 10); the shader takes it as WORDS.
-const STAMP_WORDS: u32 = 13;
-
-/// silhouettes.comp's dispatches per caster, in order (its STAGE): pairing the silhouette
-/// vertices' edge ends, finding each vertex's own corner, drawing; each reads what the ones
-/// before wrote.
-const PAIR: u32 = 0;
-const OWN: u32 = 1;
-const DRAW: u32 = 2;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -65,8 +54,7 @@ impl MeshBuffers {
         let triangles: Vec<[u32; 4]> = mesh.triangles.iter().map(|t| [t[0], t[1], t[2], 0]).collect();
         let edges: Vec<[u32; 4]> =
             mesh.adjacency.edges.iter().map(|e| [e.vertices[0], e.vertices[1], e.faces[0], e.faces[1]]).collect();
-        // Per vertex: its stamped edge-end count, its first two edge ends and its own corner
-        // (silhouettes.comp's WORDS).
+        // Per vertex: its stamped edge-end count, its first two edge ends and its own corner.
         let stamps = vec![0u32; STAMP_WORDS as usize * mesh.positions.len()];
         let mut made: Vec<Buffer> = Vec::new();
         for (name, bytes) in [
@@ -258,9 +246,9 @@ impl GpuSilhouettes {
                 offset: params_range.offset + i as u64 * PARAMS_BYTES,
                 range: PARAMS_BYTES,
             };
-            for stage in [PAIR, OWN, DRAW] {
+            for stage in [STAGE_PAIR, STAGE_OWN, STAGE_DRAW] {
                 let pipeline = self.pipelines.get((physical, stage), |&(physical, stage)| {
-                    let constants = [("PHYSICAL_SIZE", physical as u32), ("STAGE", stage), ("WORDS", STAMP_WORDS)];
+                    let constants = [("PHYSICAL_SIZE", physical as u32), ("STAGE", stage)];
                     Pipeline::compute(ctx, "silhouettes", &shaders::SMOOTHIE_SILHOUETTES_COMP, &constants)
                 })?;
                 pipeline.bind(
@@ -276,7 +264,7 @@ impl GpuSilhouettes {
                         Descriptor::Buffer(vertices),
                     ],
                 )?;
-                dispatch(ctx, cmd, mesh.edge_count.div_ceil(GROUP));
+                dispatch(ctx, cmd, mesh.edge_count.div_ceil(COMPUTE_GROUP));
                 buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::COMPUTE_READ_WRITE);
             }
         }
