@@ -12,6 +12,24 @@ pub const COMPUTE_GROUP: u32 = 64;
 /// Marks the missing second face of a boundary edge (`geometry::adjacency`).
 pub const NO_FACE: u32 = u32::MAX;
 
+/// A surface's role in shadowing (`frame::ShadowRole`) as the prepass writes it into the
+/// camera normal target's alpha.
+pub const ROLE_IGNORES: f32 = 0.0;
+pub const ROLE_RECEIVES: f32 = 0.5;
+pub const ROLE_CASTS: f32 = 1.0;
+/// What a role read back (perhaps rounded to a half float) is tested against: halfway between
+/// two codes.
+pub const ROLE_RECEIVES_ABOVE: f32 = 0.5 * (ROLE_IGNORES + ROLE_RECEIVES);
+pub const ROLE_CASTS_ABOVE: f32 = 0.5 * (ROLE_RECEIVES + ROLE_CASTS);
+
+/// The shadow-map family's resolve filters (`FILTER` of glsl/shadow_map/resolve.frag):
+/// shadow-map's one 2x2 bilinear comparison, pcf's rotated Vogel disk or 4x4 B-spline, and
+/// pcss's blocker search, penumbra estimate and PCF.
+pub const FILTER_HARD: u32 = 0;
+pub const FILTER_DISK: u32 = 1;
+pub const FILTER_BICUBIC: u32 = 2;
+pub const FILTER_PCSS: u32 = 3;
+
 // The smoothies' geometry (`geometry::smoothie` on the CPU, glsl/smoothie/silhouettes.comp on
 // the GPU: the same construction).
 

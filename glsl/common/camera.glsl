@@ -27,8 +27,8 @@ Surface read_surface(FrameGlobals frame, sampler2D depth_target, sampler2D norma
     float depth = texelFetch(depth_target, pixel, 0).r;
     vec4 normal_role = texelFetch(normal_target, pixel, 0);
     Surface s;
-    s.receives = sees_surface(depth) && normal_role.a > 0.25;
-    s.casts = normal_role.a > 0.75;
+    s.receives = sees_surface(depth) && normal_role.a > ROLE_RECEIVES_ABOVE;
+    s.casts = normal_role.a > ROLE_CASTS_ABOVE;
     s.p = s.receives ? world_position(frame.inv_view_proj, uv, depth) : vec3(0.0);
     s.n = s.receives ? normalize(normal_role.xyz) : vec3(0.0, 1.0, 0.0);
     return s;

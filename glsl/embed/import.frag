@@ -31,7 +31,7 @@ void main() {
     float depth = imported_depth(embedder_depth, pixel);
     gl_FragDepth = depth;
     if (!sees_surface(depth)) {
-        out_normal_role = vec4(0.0);
+        out_normal_role = vec4(vec3(0.0), ROLE_IGNORES);
         return;
     }
     vec3 p = world_position(frame.inv_view_proj, in_uv, depth);

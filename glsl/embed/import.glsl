@@ -10,8 +10,6 @@
 // as the engine flips the embedder's projection.
 layout(constant_id = 0) const bool REVERSE_Z = true;
 
-// ShadowRole::Receives (src/frame/mod.rs).
-const float ROLE_RECEIVES = 0.5;
 
 float imported_depth(sampler2D depth, ivec2 pixel) {
     float d = texelFetch(depth, pixel, 0).r;

@@ -6,11 +6,8 @@
 #include "shadow.glsl"
 #include "filters.glsl"
 
-const int HARD = 0;    // shadow-map: one 2x2 bilinear comparison
-const int DISK = 1;    // pcf: rotated Vogel disk
-const int BICUBIC = 2; // pcf: 4x4 B-spline
-const int PCSS = 3;    // pcss: blocker search, penumbra estimate, PCF
-layout(constant_id = 0) const int FILTER = HARD;
+// The filter: FILTER_HARD, FILTER_DISK, FILTER_BICUBIC or FILTER_PCSS (src/shader_constants.rs).
+layout(constant_id = 0) const uint FILTER = FILTER_HARD;
 // pcf's `radius_world`: the disk radius is in world units at the receiver, not texels.
 layout(constant_id = 1) const bool RADIUS_IN_WORLD = false;
 
@@ -39,9 +36,9 @@ void main() {
         return;
     }
     float size = light.bias.w;
-    if (FILTER == HARD) {
+    if (FILTER == FILTER_HARD) {
         out_visibility = compare_bilinear(shadow_map, vec2(0.0), size, l.uv, l.depth);
-    } else if (FILTER == DISK) {
+    } else if (FILTER == FILTER_DISK) {
         float radius = light.kernel.y;
         if (RADIUS_IN_WORLD) {
             // World units: divide by the world size of one texel at the receiver.
@@ -49,7 +46,7 @@ void main() {
             radius *= texels_per_tangent(light).x / z;
         }
         out_visibility = pcf_disk(shadow_map, light, l, radius, max(int(light.kernel.x), 1));
-    } else if (FILTER == BICUBIC) {
+    } else if (FILTER == FILTER_BICUBIC) {
         out_visibility = pcf_bicubic(shadow_map, light, l);
     } else {
         // The receiver-plane tests of pcss() leave a caster's own surface out of the map, so the

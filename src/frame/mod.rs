@@ -13,6 +13,7 @@ use glam::Vec3;
 use crate::geometry::{Aabb, CameraProjection};
 use crate::gpu::{Context, PassTimer, Target, VertexInput, draw_indexed};
 use crate::scene::{Scene, Vertex};
+use crate::shader_constants::{ROLE_CASTS, ROLE_CASTS_ABOVE, ROLE_IGNORES, ROLE_RECEIVES, ROLE_RECEIVES_ABOVE};
 
 /// Format of the visibility image V (DESIGN.md §3).
 pub const VISIBILITY_FORMAT: vk::Format = vk::Format::R16_UNORM;
@@ -55,22 +56,22 @@ impl ShadowRole {
     /// The value written into the normal target's alpha: 0, 0.5 or 1.
     pub fn encode(self) -> f32 {
         match self {
-            ShadowRole::Ignores => 0.0,
-            ShadowRole::Receives => 0.5,
-            ShadowRole::ReceivesAndCasts => 1.0,
+            ShadowRole::Ignores => ROLE_IGNORES,
+            ShadowRole::Receives => ROLE_RECEIVES,
+            ShadowRole::ReceivesAndCasts => ROLE_CASTS,
         }
     }
 
     /// Whether an encoded role (as read back, possibly rounded to a half float) receives:
     /// the threshold halfway between 0 and 0.5, as the shaders test it.
     pub fn receives(encoded: f32) -> bool {
-        encoded > 0.25
+        encoded > ROLE_RECEIVES_ABOVE
     }
 
     /// Whether an encoded role is [`ShadowRole::ReceivesAndCasts`]: above halfway between 0.5
     /// and 1.
     pub fn casts(encoded: f32) -> bool {
-        encoded > 0.75
+        encoded > ROLE_CASTS_ABOVE
     }
 }
 

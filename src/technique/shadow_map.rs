@@ -25,6 +25,7 @@ use crate::gpu::{
     Access, Attachment, Context, DepthState, Descriptor, Destroy, FRAMES_IN_FLIGHT, Fullscreen, Guard, PerFrame,
     Pipeline, PipelineDesc, RenderPass, Target, TargetDesc, Variants, ensure, shaders, transition,
 };
+use crate::shader_constants::{FILTER_BICUBIC, FILTER_DISK, FILTER_HARD, FILTER_PCSS};
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "shadow-map",
@@ -311,11 +312,12 @@ impl ShadowMapPass {
 
 /// The resolve variants: `FILTER` of `glsl/shadow_map/resolve.frag`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
 enum Filter {
-    Hard = 0,
-    Disk = 1,
-    Bicubic = 2,
-    Pcss = 3,
+    Hard = FILTER_HARD,
+    Disk = FILTER_DISK,
+    Bicubic = FILTER_BICUBIC,
+    Pcss = FILTER_PCSS,
 }
 
 /// `shadow-map`, `pcf` and `pcss`: one [`ShadowMapPass`], then one resolve skeleton
