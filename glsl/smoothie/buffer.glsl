@@ -9,7 +9,7 @@
 layout(set = 0, binding = 0) uniform Light { LightView light; };
 layout(set = 0, binding = 1) uniform sampler2D shadow_map;
 
-layout(location = 0) noperspective in float in_b;
+layout(location = 0) noperspective in float in_inverse_b; // 1/b (smoothie.vert)
 layout(location = 1) in vec2 in_shape; // perspective-correct: distance over size (smoothie.vert)
 layout(location = 2) noperspective in vec2 in_probe;
 layout(location = 3) flat in vec2 in_range;
@@ -28,6 +28,11 @@ float map_at(vec2 uv) {
     return texelFetch(shadow_map, ivec2(clamp(uv * size, vec2(0.0), vec2(size - 1.0))), 0).r;
 }
 
+// The blocker's linear light depth b at this fragment.
+float blocker_depth() {
+    return 1.0 / in_inverse_b;
+}
+
 // This fragment's linear alpha, 0 on the silhouette, 1 at the smoothie's far side.
 float linear_alpha() {
     return clamp(length(in_shape), 0.0, 1.0);
@@ -35,7 +40,7 @@ float linear_alpha() {
 
 // Equation 1 for a receiver at depth r; 1 where the smoothie lies at or behind it (lit there).
 float remapped_alpha(float alpha, float r) {
-    float f = in_b / r;
+    float f = blocker_depth() / r;
     return f >= 1.0 ? 1.0 : alpha / (1.0 - f);
 }
 

@@ -107,7 +107,7 @@ bool corner_open(float far) {
 // receiver at r, or an inner α, which the resolve remaps by its receiver's own r (exact where
 // that is the r taken here). `alpha` stands where r lies at or in front of b (contact: hard).
 float corner_alpha(float alpha, float r, bool inner, bool covered) {
-    float part = 1.0 - in_b / r;
+    float part = 1.0 - blocker_depth() / r;
     if (!(part > 0.0)) {
         return alpha;
     }
@@ -137,9 +137,10 @@ bool centred_fragment(out Centred c) {
     vec2 uv = gl_FragCoord.xy / light.kernel.x;
     float caster = map_at(uv);
     float alpha = linear_alpha();
-    c = Centred(INNER, alpha, depth_code(light, in_b), 1.0);
+    float b = blocker_depth();
+    c = Centred(INNER, alpha, depth_code(light, b), 1.0);
     // Two map texels' depth at b, what a face at 45° to the light spans across them.
-    float slack = 2.0 * in_b * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
+    float slack = 2.0 * b * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
     if (c.inner) {
         // An inner texel counts only where the map's blocker is this caster (its depth within the
         // caster's range, within two texels' depth; not another caster in front or behind), and
@@ -194,10 +195,10 @@ bool centred_fragment(out Centred c) {
         return false;
     }
     float ground = ground_depth(light, uv);
-    float r = in_b < caster ? min(caster, ground) : ground;
+    float r = b < caster ? min(caster, ground) : ground;
     c.alpha = remapped_alpha(alpha, r);
-    if (CORNERS && corner_open(in_b + slack)) {
-        c.alpha = corner_alpha(c.alpha, r, false, caster <= in_b + slack);
+    if (CORNERS && corner_open(b + slack)) {
+        c.alpha = corner_alpha(c.alpha, r, false, caster <= b + slack);
     }
     if (partial) {
         c.code = depth_code(light, in_range.x);

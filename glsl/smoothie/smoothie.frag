@@ -16,5 +16,5 @@ void main() {
     if (a >= 1.0) {
         discard; // hidden from the light, or lit: what the clear holds
     }
-    out_smoothie = vec2(depth_code(light, in_b), a);
+    out_smoothie = vec2(depth_code(light, blocker_depth()), a);
 }
