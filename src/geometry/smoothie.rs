@@ -1410,9 +1410,16 @@ mod tests {
         assert!(!g.inner.iter().any(carries), "the second edge past the bend carries the corner");
     }
 
+    /// What the smoothie pass interpolates at a fragment.
+    struct Interpolated {
+        shape: Vec2,
+        along: f32,
+        b: f32,
+    }
+
     /// Where `q` falls in `tri` (the smoothie pass's interpolation): the shape projectively
     /// (w = 1/t), `along` and 1/b linearly; `None` outside it or where its keep leaves `q` out.
-    fn kept_at(tri: &[SmoothieVertex], q: Vec2) -> Option<(Vec2, f32, f32)> {
+    fn kept_at(tri: &[SmoothieVertex], q: Vec2) -> Option<Interpolated> {
         let p = |k: usize| Vec2::new(tri[k].x, tri[k].y);
         let area = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
         let whole = area(p(0), p(1), p(2));
@@ -1427,7 +1434,11 @@ mod tests {
             along += l[k] * v.along;
             inverse_b += l[k] / v.b;
         }
-        (along >= tri[0].keep[0] && along < tri[0].keep[1]).then_some((shape / weight, along, 1.0 / inverse_b))
+        (along >= tri[0].keep[0] && along < tri[0].keep[1]).then_some(Interpolated {
+            shape: shape / weight,
+            along,
+            b: 1.0 / inverse_b,
+        })
     }
 
     #[test]
@@ -1449,10 +1460,10 @@ mod tests {
             for j in 0..=10 {
                 let y = rim * (1e-3 + 0.998 * j as f32 / 10.0);
                 let q = Vec2::new(x, y);
-                let kept: Vec<(&[SmoothieVertex], (Vec2, f32, f32))> =
+                let kept: Vec<(&[SmoothieVertex], Interpolated)> =
                     out.chunks(3).filter_map(|tri| kept_at(tri, q).map(|k| (tri, k))).collect();
                 assert!(!kept.is_empty(), "{q} kept by no piece");
-                for (tri, (shape, along, b)) in kept {
+                for (tri, Interpolated { shape, along, b }) in kept {
                     assert!((shape.x - y / t).abs() < 1e-4 && shape.y.abs() < 1e-6, "{q}: shape {shape}");
                     assert!((along - x).abs() < 1e-5, "{q}: along {along}");
                     assert!((b * t / 0.1 - 1.0).abs() < 1e-5, "{q}: b {b} for {}", 0.1 / t);
