@@ -602,7 +602,8 @@ fn between(a: SmoothieVertex, b: SmoothieVertex, u: f32) -> SmoothieVertex {
     SmoothieVertex {
         x: lerp(a.x, b.x),
         y: lerp(a.y, b.y),
-        b: 1.0 / lerp(1.0 / a.b, 1.0 / b.b),
+        // 1/b linear, in one division as silhouettes.comp's.
+        b: a.b * b.b / lerp(b.b, a.b),
         sx: shape(a.sx, b.sx),
         sy: shape(a.sy, b.sy),
         fx: lerp(a.fx, b.fx),
