@@ -195,7 +195,12 @@ bool centred_fragment(out Centred c) {
         return false;
     }
     float ground = ground_depth(light, uv);
-    float r = b < caster ? min(caster, ground) : ground;
+    // Where the grids differ, the map texel under this one's centre can lie on the outline's
+    // other side, on the smoothie's own caster: within the slack of b, that is no receiver in
+    // front of the ground. Taken as one, it dropped the outer alpha there (r ≈ b), and the
+    // resolve read the texel as umbra: dark speckles on the plate's hard edge once b was exact
+    // (a 1024² map over a 512² buffer, 128²: penumbra RMSE 0.0217, 0.0091 so).
+    float r = b + (SAME_GRID ? 0.0 : slack) < caster ? min(caster, ground) : ground;
     c.alpha = remapped_alpha(alpha, r);
     if (CORNERS && corner_open(b + slack)) {
         c.alpha = corner_alpha(c.alpha, r, false, caster <= b + slack);

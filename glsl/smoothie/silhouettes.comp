@@ -163,7 +163,8 @@ vec2 lerp(vec2 a, vec2 b, float u) {
 // interpolates there (src/geometry/smoothie.rs's between).
 Vertex between(Vertex a, Vertex b, float u) {
     float ta = 1.0 / a.w, tb = 1.0 / b.w, t = lerp(ta, tb, u);
-    return Vertex(lerp(a.p, b.p, u), lerp(a.b, b.b, u), lerp(a.shape * ta, b.shape * tb, u) / t, lerp(a.foot, b.foot, u),
+    // 1/b linear, in one division.
+    return Vertex(lerp(a.p, b.p, u), a.b * b.b / lerp(b.b, a.b, u), lerp(a.shape * ta, b.shape * tb, u) / t, lerp(a.foot, b.foot, u),
                   1.0 / t, lerp(a.along, b.along, u));
 }
 

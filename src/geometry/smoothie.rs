@@ -591,11 +591,9 @@ fn edge_quad(
 }
 
 /// The vertex `u` of the way from `a` to `b`, two vertices of one quad's side, with what the
-/// rasterizer interpolates there: position, foot and `along` linearly, the shape projectively by
-/// w = 1/t ([`SmoothieVertex::w`]), so a piece of a quad interpolates as the whole did; but the
-/// depth linearly, where the vertex stage interpolates 1/b (glsl/smoothie/smoothie.vert). Taken
-/// as 1/b here too (contact's penumbra RMSE 0.0178 → 0.0080), a 1024² map over a 512² buffer
-/// left dark speckles on the plate's hard edge (128²: 0.0093 → 0.0217), cause not yet found.
+/// rasterizer interpolates there: position, foot and `along` linearly, depth as 1/b
+/// (glsl/smoothie/smoothie.vert), the shape projectively by w = 1/t ([`SmoothieVertex::w`]), so
+/// a piece of a quad interpolates as the whole did.
 fn between(a: SmoothieVertex, b: SmoothieVertex, u: f32) -> SmoothieVertex {
     let lerp = |x: f32, y: f32| x + (y - x) * u;
     let (ta, tb) = (1.0 / a.w, 1.0 / b.w);
@@ -604,7 +602,8 @@ fn between(a: SmoothieVertex, b: SmoothieVertex, u: f32) -> SmoothieVertex {
     SmoothieVertex {
         x: lerp(a.x, b.x),
         y: lerp(a.y, b.y),
-        b: lerp(a.b, b.b),
+        // 1/b linear, in one division as silhouettes.comp's.
+        b: a.b * b.b / lerp(b.b, a.b),
         sx: shape(a.sx, b.sx),
         sy: shape(a.sy, b.sy),
         fx: lerp(a.fx, b.fx),
@@ -1412,9 +1411,16 @@ mod tests {
         assert!(!g.inner.iter().any(carries), "the second edge past the bend carries the corner");
     }
 
+    /// What the smoothie pass interpolates at a fragment.
+    struct Interpolated {
+        shape: Vec2,
+        along: f32,
+        b: f32,
+    }
+
     /// Where `q` falls in `tri` (the smoothie pass's interpolation): the shape projectively
-    /// (w = 1/t) and `along` linearly; `None` outside it or where its keep leaves `q` out.
-    fn kept_at(tri: &[SmoothieVertex], q: Vec2) -> Option<(Vec2, f32)> {
+    /// (w = 1/t), `along` and 1/b linearly; `None` outside it or where its keep leaves `q` out.
+    fn kept_at(tri: &[SmoothieVertex], q: Vec2) -> Option<Interpolated> {
         let p = |k: usize| Vec2::new(tri[k].x, tri[k].y);
         let area = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
         let whole = area(p(0), p(1), p(2));
@@ -1422,22 +1428,28 @@ mod tests {
             return None;
         }
         let l = [area(q, p(1), p(2)) / whole, area(p(0), q, p(2)) / whole, area(p(0), p(1), q) / whole];
-        let (mut shape, mut weight, mut along) = (Vec2::ZERO, 0.0, 0.0);
+        let (mut shape, mut weight, mut along, mut inverse_b) = (Vec2::ZERO, 0.0, 0.0, 0.0);
         for (k, v) in tri.iter().enumerate() {
             shape += l[k] * Vec2::new(v.sx, v.sy) / v.w;
             weight += l[k] / v.w;
             along += l[k] * v.along;
+            inverse_b += l[k] / v.b;
         }
-        (along >= tri[0].keep[0] && along < tri[0].keep[1]).then_some((shape / weight, along))
+        (along >= tri[0].keep[0] && along < tri[0].keep[1]).then_some(Interpolated {
+            shape: shape / weight,
+            along,
+            b: 1.0 / inverse_b,
+        })
     }
 
     #[test]
     fn a_cut_quad_s_pieces_interpolate_as_the_whole_and_keep_every_point() {
         // An edge from (0, 0) to (1, 0), its quad out along +y to t·k, t growing from 0.1 to 0.3
-        // and the reach k falling from 1 to 0.8 (α = y / t throughout); corners at both ends,
-        // cut at 0.2 and 0.3 of the way.
+        // and the reach k falling from 1 to 0.8 (α = y / t throughout), its depth b = 0.1 / t
+        // (the physical size, t = R / b), so that 1/b, not b, is linear along the edge; corners
+        // at both ends, cut at 0.2 and 0.3 of the way.
         let (ta, tb, kb) = (0.1, 0.3, 0.8);
-        let at = |x: f32, t: f32, alpha: f32| weighted(vertex(Vec2::new(x, alpha * t), 1.0, Vec2::X * alpha), t);
+        let at = |x: f32, t: f32, alpha: f32| weighted(vertex(Vec2::new(x, alpha * t), 0.1 / t, Vec2::X * alpha), t);
         let q = [at(0.0, ta, 0.0), at(1.0, tb, 0.0), at(1.0, tb, kb), at(0.0, ta, 1.0)];
         let corner = ShadowCorner { at: Vec2::ZERO, normals: [Vec2::NEG_Y, Vec2::NEG_X], convex: true, chamfer: None };
         let mut out = Vec::new();
@@ -1449,12 +1461,13 @@ mod tests {
             for j in 0..=10 {
                 let y = rim * (1e-3 + 0.998 * j as f32 / 10.0);
                 let q = Vec2::new(x, y);
-                let kept: Vec<(&[SmoothieVertex], (Vec2, f32))> =
+                let kept: Vec<(&[SmoothieVertex], Interpolated)> =
                     out.chunks(3).filter_map(|tri| kept_at(tri, q).map(|k| (tri, k))).collect();
                 assert!(!kept.is_empty(), "{q} kept by no piece");
-                for (tri, (shape, along)) in kept {
+                for (tri, Interpolated { shape, along, b }) in kept {
                     assert!((shape.x - y / t).abs() < 1e-4 && shape.y.abs() < 1e-6, "{q}: shape {shape}");
                     assert!((along - x).abs() < 1e-5, "{q}: along {along}");
+                    assert!((b * t / 0.1 - 1.0).abs() < 1e-5, "{q}: b {b} for {}", 0.1 / t);
                     // Within the cuts' slack both pieces keep it; elsewhere only its own.
                     let at_cut = [cuts[0], 1.0 - cuts[1]].iter().any(|c| (x - c).abs() < KEEP_SLACK);
                     let near = x < cuts[0] || x > 1.0 - cuts[1];
