@@ -10,7 +10,6 @@
 // as the engine flips the embedder's projection.
 layout(constant_id = 0) const bool REVERSE_Z = true;
 
-
 float imported_depth(sampler2D depth, ivec2 pixel) {
     float d = texelFetch(depth, pixel, 0).r;
     return REVERSE_Z ? d : 1.0 - d;

@@ -66,8 +66,8 @@ float footprint_angle(vec4 axes, vec2 one, vec2 other) {
 }
 
 // Whether the hard shadow about a corner at `at` (plane units) is what its two lines (outward
-// normals `one`, `other`) say: the mask MASK_PROBE texels out along the four bisectors of the lines,
-// shadow in only the one inside both (convex) or in all but the one outside both (reflex). Not
+// normals `one`, `other`) say: the mask MASK_PROBE texels out along the four bisectors of the
+// lines, shadow in only the one inside both (convex) or in all but the one outside both (reflex). Not
 // where the other edge is an interior fold (the cow's legs against its body) or lies off the
 // boundary, or where a spike is too thin for the mask to show: no corner there. Unchecked,
 // corners at the cow's legs drew its umbra lit (default's penumbra RMSE 0.169, 0.141 checked,

@@ -163,9 +163,9 @@ vec2 lerp(vec2 a, vec2 b, float u) {
 // interpolates there (src/geometry/smoothie.rs's between).
 Vertex between(Vertex a, Vertex b, float u) {
     float ta = 1.0 / a.w, tb = 1.0 / b.w, t = lerp(ta, tb, u);
-    // 1/b linear, in one division.
-    return Vertex(lerp(a.p, b.p, u), a.b * b.b / lerp(b.b, a.b, u), lerp(a.shape * ta, b.shape * tb, u) / t, lerp(a.foot, b.foot, u),
-                  1.0 / t, lerp(a.along, b.along, u));
+    float depth = a.b * b.b / lerp(b.b, a.b, u); // 1/b linear, in one division
+    return Vertex(lerp(a.p, b.p, u), depth, lerp(a.shape * ta, b.shape * tb, u) / t, lerp(a.foot, b.foot, u), 1.0 / t,
+                  lerp(a.along, b.along, u));
 }
 
 // How far along its edges a corner's pieces carry it, in quad widths
@@ -223,12 +223,12 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
 }
 
 // Three dispatches per caster, as src/geometry/smoothie.rs groups edge ends by vertex and finds
-// each vertex's own corner once: STAGE_PAIR counts each silhouette vertex's edge ends (stamped, so no
-// clear is needed) and keeps the first two; STAGE_OWN has each vertex's first end find the hard
-// shadow's corner there (centred); then STAGE_DRAW, where each vertex's first end draws its corner, a
-// wedge from both ends' sides where exactly two meet, else a full square, and each edge its
-// quads, carrying the corners near its ends. Found in STAGE_DRAW, each vertex's own corner would be
-// found again by every search that passed it, each time walking its runs (as the CPU path,
+// each vertex's own corner once: STAGE_PAIR counts each silhouette vertex's edge ends (stamped,
+// so no clear is needed) and keeps the first two; STAGE_OWN has each vertex's first end find the
+// hard shadow's corner there (centred); then STAGE_DRAW, where each vertex's first end draws its
+// corner, a wedge from both ends' sides where exactly two meet, else a full square, and each edge
+// its quads, carrying the corners near its ends. Found in STAGE_DRAW, each vertex's own corner
+// would be found again by every search that passed it, each time walking its runs (as the CPU path,
 // which keeps them per vertex, does not).
 layout(constant_id = 1) const uint STAGE = STAGE_PAIR;
 
