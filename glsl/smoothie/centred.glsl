@@ -18,12 +18,6 @@ layout(constant_id = 2) const bool CHAMFER = false;
 // The map's texels are the buffer's (equal sizes over one frustum), as the resolve's SAME_GRID.
 layout(constant_id = 3) const bool SAME_GRID = true;
 
-// What an inner quad with α < 1 leaves in the outer smoothies' depth channel, where the
-// resolve's mask draw finds every smoothie with one gather (resolve.frag's near_smoothie): the
-// largest code below 1, behind every receiver the frustum holds, so that no receiver counts as
-// behind it.
-const float INNER_MARK = 65534.0 / 65535.0;
-
 // How the centred buffer stores an alpha: ½ + ½α. Near a corner V goes past what either edge
 // alone gives, an outer α' or an inner α below 0 (corner_alpha); 1 is still the clear's, lit
 // outside and umbra inside. The resolve reads it back (resolve.frag's texels).

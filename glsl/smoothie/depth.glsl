@@ -16,6 +16,12 @@
 // smoothie it decides for (the resolve's LIMIT_SLACK, centred.glsl's partial smoothies).
 const float APART = 1.02;
 
+// What an inner quad with α < 1 (centred.glsl) leaves in the outer smoothies' depth channel,
+// where the resolve's mask draw finds every smoothie with one gather (resolve.frag's
+// near_smoothie): the largest code below 1, behind every receiver the frustum holds, so that no
+// receiver counts as behind it.
+const float INNER_MARK = 65534.0 / 65535.0;
+
 // 0 at (and before) near, 1 at far and beyond: an empty texel's code, behind any receiver.
 float depth_code(LightView light, float depth) {
     return clamp(log2(depth / light.depths.x) / light.depths.z, 0.0, 1.0);
