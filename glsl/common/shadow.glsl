@@ -82,9 +82,14 @@ float bilinear(vec2 f, vec4 v) {
     return mix(mix(v.w, v.z, f.x), mix(v.x, v.y, f.x), f.y);
 }
 
-// The four texels compared with `depth` (1 = lit), bilinearly weighted.
+// The four texels compared with `depth`, 1 where lit, in gather order.
+vec4 lit_texels(MapTexels m, float depth) {
+    return vec4(greaterThanEqual(m.d, vec4(depth)));
+}
+
+// The same, bilinearly weighted.
 float lit_bilinear(MapTexels m, float depth) {
-    return bilinear(m.f, vec4(greaterThanEqual(m.d, vec4(depth))));
+    return bilinear(m.f, lit_texels(m, depth));
 }
 
 float compare_bilinear(sampler2D atlas, vec2 origin, float size, vec2 uv, float depth) {

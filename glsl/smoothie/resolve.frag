@@ -228,12 +228,13 @@ bool near_smoothie(vec2 uv, float depth, float umbra, MapTexels map) {
         // An outer smoothie is written only with α' < 1 (centred.glsl), so its depth tells, and
         // an inner quad with α < 1 leaves its mark there too.
         vec4 b = textureGather(smoothies, corner, 0);
-        // Inner quads' marks alone (or nothing) over a receiver the map finds lit at all four
-        // texels: none is shadowed, so centred_test reads no inner half and its V is the hard
-        // test's. Most are a caster's own lit surface over its inner quads: the penumbra draw
-        // shades 0.38 (contact) to 0.91 (low_light) of the pixels it did without this.
+        // Inner quads' marks alone (or the clear's 1; half a 16-bit step below the mark, as the
+        // target rounds it) over a receiver the map finds lit at all four texels: none is
+        // shadowed, so centred_test reads no inner half and its V is the hard test's. Most are a
+        // caster's own lit surface over its inner quads: the penumbra draw shades 0.38 (contact)
+        // to 0.91 (low_light) of the pixels it did without this.
         bool lit_over_inner = SAME_GRID && all(greaterThan(b, vec4(INNER_MARK - 0.5 / 65535.0)))
-            && all(greaterThanEqual(map.d, vec4(depth)));
+            && min4(lit_texels(map, depth)) == 1.0;
         return edge || (any(lessThan(b, vec4(1.0))) && !lit_over_inner);
     }
     if (umbra == 0.0) {
