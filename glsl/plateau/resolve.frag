@@ -22,7 +22,9 @@ layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Plateau { PlateauView plateau; };
 layout(set = 0, binding = 2) uniform sampler2D camera_depth;
 layout(set = 0, binding = 3) uniform sampler2D camera_normal;
-layout(set = 0, binding = 4) uniform sampler2D plateau_texture;
+// Read as integers (R16_UINT, or R32_UINT over R16G16_UNORM, src/technique/plateau.rs): one
+// gather brings both channels, the first in the low 16 bits.
+layout(set = 0, binding = 4) uniform usampler2D plateau_texture;
 layout(set = 0, binding = 5) uniform sampler2D umbra_mask;
 
 layout(location = 0) in vec2 in_uv;
@@ -53,15 +55,16 @@ float channel_v(float s) {
 // Bilinear from the texels (the sampler is nearest): the gradient stays smooth, and where t is
 // 0 on the hard edge the sign flips without a step. The four texels come in gathers, in gather
 // order (i0,j1) (i1,j1) (i1,j0) (i0,j0): llvmpipe runs every branch of a fragment shader, and
-// three gathers cost it less than eight fetches.
+// two gathers cost it less than eight fetches.
 vec2 plateau_s(vec2 tc) {
     vec2 size = vec2(textureSize(plateau_texture, 0));
     vec2 pos = clamp(tc * size - 0.5, vec2(0.0), size - 1.001);
     vec2 f = fract(pos);
     vec2 corner = (floor(pos) + 1.0) / size;
-    // Stored as ½ + ½·t (penumbra.frag).
-    vec4 r = 2.0 * textureGather(plateau_texture, corner, 0) - 1.0;
-    vec4 g = CENTRED && CHANNELS ? 2.0 * textureGather(plateau_texture, corner, 1) - 1.0 : vec4(1.0);
+    // Stored as ½ + ½·t (penumbra.frag), in unorm16.
+    uvec4 packed = textureGather(plateau_texture, corner, 0);
+    vec4 r = 2.0 * vec4(packed & 0xffffu) / 65535.0 - 1.0;
+    vec4 g = CENTRED && CHANNELS ? 2.0 * vec4(packed >> 16u) / 65535.0 - 1.0 : vec4(1.0);
     uvec4 casters = uvec4(round(textureGather(umbra_mask, corner, 0) * 65535.0));
     vec2 s[4];
     for (int k = 0; k < 4; k++) {

@@ -16,6 +16,9 @@ use crate::error::{Error, Result, VkContext};
 pub enum Descriptor<'a> {
     Buffer(vk::DescriptorBufferInfo),
     Image(&'a Target),
+    /// The target's texels as the format it was made to be reinterpreted as
+    /// ([`TargetDesc::reinterpreted_as`](super::TargetDesc::reinterpreted_as)).
+    Reinterpreted(&'a Target),
 }
 
 /// Vertex streams a pipeline reads.
@@ -464,11 +467,16 @@ impl Pipeline {
         for (b, input) in self.bindings.iter().zip(inputs) {
             match (b.kind, input) {
                 (Binding::Uniform | Binding::Storage, Descriptor::Buffer(info)) => buffers.push([*info]),
-                (Binding::Sampled, Descriptor::Image(t)) => images.push([vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: t.view,
-                    image_layout: t.last.layout,
-                }]),
+                (Binding::Sampled, &Descriptor::Image(t)) => images.push(sampled(t, t.view)),
+                (Binding::Sampled, &Descriptor::Reinterpreted(t)) if t.reinterpreted != vk::ImageView::null() => {
+                    images.push(sampled(t, t.reinterpreted))
+                }
+                (Binding::Sampled, Descriptor::Reinterpreted(t)) => {
+                    return Err(mismatch(format!(
+                        "binding {} `{}` reads `{}` reinterpreted, which has no such view",
+                        b.binding, b.name, t.desc.name
+                    )));
+                }
                 (kind, _) => {
                     let given = if matches!(input, Descriptor::Buffer(_)) { "a buffer" } else { "an image" };
                     return Err(mismatch(format!("binding {} `{}` is {kind:?}, given {given}", b.binding, b.name)));
@@ -542,6 +550,11 @@ impl<K> Variants<K> {
     }
 }
 
+/// A sampled binding's view of `t` (the sampler is the layout's immutable one).
+fn sampled(t: &Target, view: vk::ImageView) -> [vk::DescriptorImageInfo; 1] {
+    [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: view, image_layout: t.last.layout }]
+}
+
 fn descriptor_type(kind: Binding) -> vk::DescriptorType {
     match kind {
         Binding::Uniform => vk::DescriptorType::UNIFORM_BUFFER,
@@ -605,7 +618,7 @@ fn shader_module(ctx: &Context, words: &[u32]) -> Result<vk::ShaderModule> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gpu::ContextOptions;
+    use crate::gpu::{ContextOptions, TargetDesc};
 
     /// The shaders, not the call site, declare the bindings and constants: a call that
     /// disagrees is an error naming the shader and the binding or constant.
@@ -628,6 +641,16 @@ mod tests {
         assert!(e.contains("4 inputs") && e.contains("5 bindings") && e.contains("shadow_map"), "{e}");
         let e = pipeline.bind(&ctx, cmd, &[buffer; 5]).unwrap_err().to_string();
         assert!(e.contains("binding 2 `camera_depth`") && e.contains("given a buffer"), "{e}");
+        // A target read as another format must have been made with a view of it.
+        let plain = Target::new(&ctx, TargetDesc::color("plain", vk::Format::R16G16_UNORM, 4, 4)).unwrap();
+        let images = [Descriptor::Reinterpreted(&plain), Descriptor::Image(&plain), Descriptor::Image(&plain)];
+        let e = pipeline.bind(&ctx, cmd, &[&[buffer; 2][..], &images].concat()).unwrap_err().to_string();
+        assert!(e.contains("binding 2 `camera_depth`") && e.contains("`plain` reinterpreted"), "{e}");
+        let packed = TargetDesc::color("packed", vk::Format::R16G16_UNORM, 4, 4).reinterpreted_as(vk::Format::R32_UINT);
+        let packed = Target::new(&ctx, packed).unwrap();
+        assert_ne!(packed.reinterpreted, vk::ImageView::null());
+        plain.destroy(&ctx);
+        packed.destroy(&ctx);
         unsafe { ctx.device.destroy_command_pool(pool, ctx.host_allocator()) };
         pipeline.destroy(&ctx);
         let mut ctx = ctx;

@@ -245,7 +245,8 @@ impl Swapchain {
         self.handle = handle;
         ctx.name(handle, "swapchain");
         let images = unsafe { self.loader.get_swapchain_images(handle) }.vk("vkGetSwapchainImagesKHR")?;
-        let desc = TargetDesc { name: "swapchain image", format: self.format.format, extent, usage };
+        let desc =
+            TargetDesc { name: "swapchain image", format: self.format.format, extent, usage, reinterpreted: None };
         for image in images {
             self.images.push(Target::wrap(ctx, desc, image, None, Access::NONE)?);
             self.rendered.push(semaphore(ctx)?);

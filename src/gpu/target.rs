@@ -17,6 +17,11 @@ pub struct TargetDesc {
     pub format: vk::Format,
     pub extent: vk::Extent2D,
     pub usage: vk::ImageUsageFlags,
+    /// A second view that reads the same texels as another format of the same size (R16G16_UNORM
+    /// as R32_UINT: both channels in one gather), bound with [`Descriptor::Reinterpreted`].
+    ///
+    /// [`Descriptor::Reinterpreted`]: super::Descriptor::Reinterpreted
+    pub reinterpreted: Option<vk::Format>,
 }
 
 impl TargetDesc {
@@ -27,6 +32,7 @@ impl TargetDesc {
             format,
             extent: vk::Extent2D { width, height },
             usage: vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            reinterpreted: None,
         }
     }
 
@@ -37,6 +43,7 @@ impl TargetDesc {
             format: vk::Format::D32_SFLOAT,
             extent: vk::Extent2D { width, height },
             usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            reinterpreted: None,
         }
     }
 
@@ -49,6 +56,12 @@ impl TargetDesc {
     /// Adds usages (`SAMPLED` to read a depth target, `TRANSFER_SRC` to read one back).
     pub fn usage(mut self, extra: vk::ImageUsageFlags) -> Self {
         self.usage |= extra;
+        self
+    }
+
+    /// Adds a view reading the texels as `format`, which must be of the same size per texel.
+    pub fn reinterpreted_as(mut self, format: vk::Format) -> Self {
+        self.reinterpreted = Some(format);
         self
     }
 
@@ -83,6 +96,8 @@ pub struct Target {
     pub desc: TargetDesc,
     pub(crate) image: vk::Image,
     pub(crate) view: vk::ImageView,
+    /// The view of `desc.reinterpreted`, null without one.
+    pub(crate) reinterpreted: vk::ImageView,
     allocation: Option<Allocation>,
     owns: Owns,
     pub(crate) last: Access,
@@ -93,7 +108,9 @@ impl Target {
     pub fn new(ctx: &Context, desc: TargetDesc) -> Result<Self> {
         check_extent(ctx, &desc)?;
         let vk::Extent2D { width, height } = desc.extent;
-        let ci = vk::ImageCreateInfo::default()
+        let formats: Vec<vk::Format> = std::iter::once(desc.format).chain(desc.reinterpreted).collect();
+        let mut format_list = vk::ImageFormatListCreateInfo::default().view_formats(&formats);
+        let mut ci = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
             .extent(vk::Extent3D { width, height, depth: 1 })
@@ -103,6 +120,10 @@ impl Target {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
+        if desc.reinterpreted.is_some() {
+            // Listing the formats lets a driver keep what compression both allow.
+            ci = ci.flags(vk::ImageCreateFlags::MUTABLE_FORMAT).push_next(&mut format_list);
+        }
         let image = unsafe { ctx.device.create_image(&ci, ctx.host_allocator()) }.vk("vkCreateImage")?;
         let requirements = unsafe { ctx.device.get_image_memory_requirements(image) };
         let alloc_desc = AllocationCreateDesc {
@@ -116,6 +137,7 @@ impl Target {
             desc,
             image,
             view: vk::ImageView::null(),
+            reinterpreted: vk::ImageView::null(),
             allocation: None,
             owns: Owns::Everything,
             last: Access::NONE,
@@ -132,8 +154,14 @@ impl Target {
             target.destroy(ctx);
             return Err(Error::Vulkan { call: "vkBindImageMemory", result });
         }
-        match create_view(ctx, image, &desc) {
-            Ok(v) => target.view = v,
+        let views = create_view(ctx, image, &desc).and_then(|v| {
+            target.view = v;
+            desc.reinterpreted.map_or(Ok(vk::ImageView::null()), |format| {
+                view_of(ctx, image, &TargetDesc { format, ..desc }, desc.aspect())
+            })
+        });
+        match views {
+            Ok(v) => target.reinterpreted = v,
             Err(e) => {
                 target.destroy(ctx);
                 return Err(e);
@@ -158,7 +186,8 @@ impl Target {
             Some(v) => (v, Owns::Nothing),
             None => (create_view(ctx, image, &desc)?, Owns::View),
         };
-        Ok(Target { desc, image, view, allocation: None, owns, last: current })
+        let reinterpreted = vk::ImageView::null();
+        Ok(Target { desc, image, view, reinterpreted, allocation: None, owns, last: current })
     }
 
     /// [`Target::wrap`] for an image that passes only sample (the embedder's depth): the view
@@ -169,7 +198,8 @@ impl Target {
         let aspect = desc.aspect();
         let sampled = if aspect.contains(vk::ImageAspectFlags::DEPTH) { vk::ImageAspectFlags::DEPTH } else { aspect };
         let view = view_of(ctx, image, &desc, sampled)?;
-        Ok(Target { desc, image, view, allocation: None, owns: Owns::View, last: current })
+        let reinterpreted = vk::ImageView::null();
+        Ok(Target { desc, image, view, reinterpreted, allocation: None, owns: Owns::View, last: current })
     }
 
     /// The image (ours or wrapped), for an embedder to read what the engine wrote.
@@ -220,6 +250,7 @@ impl Target {
         unsafe {
             if self.owns != Owns::Nothing {
                 ctx.device.destroy_image_view(self.view, ctx.host_allocator());
+                ctx.device.destroy_image_view(self.reinterpreted, ctx.host_allocator());
             }
             if self.owns == Owns::Everything {
                 ctx.device.destroy_image(self.image, ctx.host_allocator());

@@ -183,8 +183,13 @@ pub(super) struct Wrapped {
 impl Wrapped {
     pub fn new(ctx: &Context, frame: &EmbeddedFrame) -> Result<Self> {
         let sampled = |name, image: &EmbedderImage| {
-            let desc =
-                TargetDesc { name, format: image.format, extent: image.extent, usage: vk::ImageUsageFlags::SAMPLED };
+            let desc = TargetDesc {
+                name,
+                format: image.format,
+                extent: image.extent,
+                usage: vk::ImageUsageFlags::SAMPLED,
+                reinterpreted: None,
+            };
             Target::wrap_for_sampling(ctx, desc, image.image, image.last)
         };
         let mut made = Wrapped { depth: sampled("embedder depth", &frame.depth)?, normal: None, visibility: None };
