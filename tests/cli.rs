@@ -92,7 +92,10 @@ fn techniques_lists_knobs_with_defaults() {
         out.status.success()
             && text.contains("shadow-map")
             && text.contains("shadow_map_size")
-            && text.contains("2048"),
+            && text.contains("2048")
+            // Named values (`--set penumbra=centred`) are listed with their numbers.
+            && text.contains("values 0 outer, 1 centred")
+            && text.contains("values 0 linear, 1 sine, 2 smoothstep, 3 disk"),
         "{text}"
     );
 }

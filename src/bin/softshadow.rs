@@ -189,7 +189,11 @@ fn run(cli: Cli) -> Result<()> {
             for t in TECHNIQUES {
                 out!("{}: {}", t.name, t.summary);
                 for k in t.knobs {
-                    out!("    {:<16} default {:<8} range {}..={}  {}", k.name, k.default, k.min, k.max, k.help);
+                    let range = match k.choices {
+                        [] => format!("range {}..={}", k.min, k.max),
+                        _ => format!("values {}", k.choice_list()),
+                    };
+                    out!("    {:<16} default {:<8} {range}  {}", k.name, k.default, k.help);
                 }
             }
             Ok(())

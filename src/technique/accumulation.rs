@@ -27,6 +27,7 @@ pub(crate) const SAMPLES: Knob = Knob {
     min: 1.0,
     max: 1024.0,
     integer: true,
+    choices: &[],
     help: "points on the light, one hard shadow each, accumulated with the reference's weights",
 };
 

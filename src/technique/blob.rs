@@ -49,6 +49,7 @@ const SOFTNESS: Knob = Knob {
     min: 0.01,
     max: 1.0,
     integer: false,
+    choices: &[],
     help: "half width of the soft edge, as a fraction of the spot's radius",
 };
 

@@ -64,6 +64,7 @@ const PROJECTIONS: Knob = Knob {
     min: 1.0,
     max: 64.0,
     integer: true,
+    choices: &[],
     help: "planar projections averaged (N)",
 };
 const SPREAD_SCALE: Knob = Knob {
@@ -72,6 +73,7 @@ const SPREAD_SCALE: Knob = Knob {
     min: 0.0,
     max: 8.0,
     integer: false,
+    choices: &[],
     help: "half spread of the planes, as a multiple of the one giving the physical penumbra",
 };
 const TEXTURE_SIZE: Knob = Knob {
@@ -80,6 +82,7 @@ const TEXTURE_SIZE: Knob = Knob {
     min: 16.0,
     max: 8192.0,
     integer: true,
+    choices: &[],
     help: "plan-view texture width and height, in texels",
 };
 

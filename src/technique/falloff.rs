@@ -10,17 +10,20 @@ use super::knobs::Knob;
 /// The knob choosing the curve. Linear is the default: it measured best against the reference
 /// for both plateaus and smoothies (the outer-only penumbrae start at the hard edge, where the
 /// true V is already ½, and the sine and smoothstep curves stay darker longer).
-pub const FALLOFF: Knob = Knob {
-    name: "falloff",
-    default: 0.0,
-    min: 0.0,
-    max: 3.0,
-    integer: true,
-    help: "gradient: 0 linear, 1 sine (Haines 3), 2 smoothstep (Parker), 3 disk edge (exact for a straight edge)",
-};
+pub const FALLOFF: Knob = Knob::choice(
+    "falloff",
+    0.0,
+    &["linear", "sine", "smoothstep", "disk"],
+    "gradient: linear, sine (Haines 3), smoothstep (Parker), disk edge (exact for a straight edge)",
+);
 
 /// Where the penumbra lies (issue 20): 0, the papers' outer-only form, grown outward from the
 /// hard shadow, whose whole area stays umbra (Haines §4, Chan & Durand §3); 1, centred on the
 /// hard edge with the physical width, V = ½ on the edge and the umbra shrinking as the light
 /// grows. A technique whose measured default differs declares `Knob { default: 1.0, ..PENUMBRA }`.
-pub const PENUMBRA: Knob = Knob::switch("penumbra", "penumbra: 0 outer only (the papers), 1 centred on the hard edge");
+pub const PENUMBRA: Knob = Knob::choice(
+    "penumbra",
+    0.0,
+    &["outer", "centred|centered"],
+    "outer only (the papers), or centred on the hard edge",
+);

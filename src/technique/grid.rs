@@ -13,6 +13,7 @@ pub const PENUMBRA_TEXELS: Knob = Knob {
     min: 0.0,
     max: 1024.0,
     integer: false,
+    choices: &[],
     help: "halve the grids (at most twice) while the narrowest penumbra spans this many texels; 0: off",
 };
 

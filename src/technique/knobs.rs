@@ -16,13 +16,42 @@ pub struct Knob {
     pub max: f64,
     /// Only whole numbers are accepted.
     pub integer: bool,
+    /// Names of the whole values from 0 up, each accepted in place of its number
+    /// (`penumbra=outer`); `|` separates a name's spellings (`centred|centered`).
+    pub choices: &'static [&'static str],
     pub help: &'static str,
 }
+
+/// What a switch's values are called.
+const OFF_ON: &[&str] = &["off|false", "on|true"];
 
 impl Knob {
     /// A knob that is off (0, the default) or on (1).
     pub const fn switch(name: &'static str, help: &'static str) -> Self {
-        Knob { name, default: 0.0, min: 0.0, max: 1.0, integer: true, help }
+        Knob { name, default: 0.0, min: 0.0, max: 1.0, integer: true, choices: OFF_ON, help }
+    }
+
+    /// A knob choosing one of `choices`, by name or by number (0, 1, …).
+    pub const fn choice(
+        name: &'static str,
+        default: f64,
+        choices: &'static [&'static str],
+        help: &'static str,
+    ) -> Self {
+        Knob { name, default, min: 0.0, max: (choices.len() - 1) as f64, integer: true, choices, help }
+    }
+
+    /// The value a name of `choices` stands for.
+    fn named(&self, name: &str) -> Option<f64> {
+        let name = name.trim();
+        self.choices.iter().position(|c| c.split('|').any(|n| n.eq_ignore_ascii_case(name))).map(|i| i as f64)
+    }
+
+    /// `choices` for a listing: `0 outer, 1 centred`, a name's first spelling only.
+    pub fn choice_list(&self) -> String {
+        let first = |c: &&str| c.split('|').next().unwrap_or_default().to_string();
+        let names: Vec<_> = self.choices.iter().map(first).enumerate().map(|(i, n)| format!("{i} {n}")).collect();
+        names.join(", ")
     }
 }
 
@@ -46,10 +75,14 @@ impl Params {
             let names: Vec<_> = t.knobs.iter().map(|k| k.name).collect();
             Error::Invalid(format!("technique `{}` has no knob `{key}` (knobs: {})", t.name, names.join(", ")))
         })?;
-        let v: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| Error::Invalid(format!("knob `{key}` of `{}`: `{value}` is not a number", t.name)))?;
+        let v: f64 = knob.named(value).map_or_else(|| value.trim().parse(), Ok).map_err(|_| {
+            let names: Vec<_> = knob.choices.iter().flat_map(|c| c.split('|')).collect();
+            let what = match names[..] {
+                [] => "not a number".to_string(),
+                _ => format!("neither a number nor one of {}", names.join(", ")),
+            };
+            Error::Invalid(format!("knob `{key}` of `{}`: `{value}` is {what}", t.name))
+        })?;
         if !v.is_finite() || v < knob.min || v > knob.max || (knob.integer && v.fract() != 0.0) {
             let kind = if knob.integer { "a whole number" } else { "a number" };
             return Err(Error::Invalid(format!(
@@ -106,5 +139,29 @@ mod tests {
         assert!(e.contains("whole number"), "{e}");
         assert!(p.set("shadow_map_size", "nan").is_err());
         assert!(find("plateu").unwrap_err().to_string().contains("plateu"));
+    }
+
+    /// Issue 20 names the penumbra knob's values `outer | centered`: a knob's values may be given
+    /// by name, in any case and any listed spelling, or by number, and a name it does not have is
+    /// an error listing those it has.
+    #[test]
+    fn named_values_stand_for_their_numbers() {
+        let mut p = Params::defaults(find("plateau").unwrap());
+        let penumbra = &crate::technique::falloff::PENUMBRA;
+        p.set("penumbra", "outer").unwrap();
+        assert_eq!(p.get(penumbra), 0.0);
+        for centred in ["centred", "Centered", " centered ", "1"] {
+            p.set("penumbra", "outer").unwrap();
+            p.set("penumbra", centred).unwrap();
+            assert_eq!(p.get(penumbra), 1.0, "{centred}");
+        }
+        p.set("falloff", "disk").unwrap();
+        assert_eq!(p.get(&crate::technique::falloff::FALLOFF), 3.0);
+        let e = p.set("penumbra", "inner").unwrap_err().to_string();
+        assert!(e.contains("`inner`") && e.contains("outer, centred, centered"), "{e}");
+        // A knob without names takes numbers only, and says so.
+        let e = p.set("penumbra_scale", "wide").unwrap_err().to_string();
+        assert!(e.ends_with("is not a number"), "{e}");
+        assert_eq!(penumbra.choice_list(), "0 outer, 1 centred");
     }
 }

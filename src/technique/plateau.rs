@@ -182,6 +182,7 @@ const TEXTURE_SIZE: Knob = Knob {
     min: 16.0,
     max: 8192.0,
     integer: true,
+    choices: &[],
     help: "plateau texture width and height, in texels (the largest: see penumbra_texels)",
 };
 /// Centred, the textures sized to the narrowest penumbra ([`grid::halvings`]; the narrowest:
@@ -196,20 +197,19 @@ const PENUMBRA_TEXELS: Knob = Knob {
     help: "centred: halve the textures (at most twice) while the narrowest penumbra spans this many texels; 0: off",
     ..grid::PENUMBRA_TEXELS
 };
-const SIZE_MODE: Knob = Knob {
-    name: "size_mode",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "0: penumbra from the light sphere; 1: Haines' constant factor times height",
-};
+const SIZE_MODE: Knob = Knob::choice(
+    "size_mode",
+    0.0,
+    &["physical", "haines"],
+    "0: penumbra from the light sphere; 1: Haines' constant factor times height",
+);
 const PENUMBRA_SCALE: Knob = Knob {
     name: "penumbra_scale",
     default: 1.0,
     min: 0.0,
     max: 8.0,
     integer: false,
+    choices: &[],
     help: "physical mode: cone radius as a multiple of the true penumbra's half width",
 };
 const HAINES_FACTOR: Knob = Knob {
@@ -218,35 +218,30 @@ const HAINES_FACTOR: Knob = Knob {
     min: 0.0,
     max: 10.0,
     integer: false,
+    choices: &[],
     help: "size_mode 1: cone radius per unit of height (Haines used 0.1)",
 };
-const EDGES: Knob = Knob {
-    name: "edges",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "0 the shadow's outline (silhouettes, and an open mesh's boundary edges), 1 every light-facing polygon (§3)",
-};
+const EDGES: Knob = Knob::choice(
+    "edges",
+    0.0,
+    &["outline", "polygons"],
+    "0 the shadow's outline (silhouettes, and an open mesh's boundary edges), 1 every light-facing polygon (§3)",
+);
 /// Whole cones as Haines drew them (§2), against which the corner wedges are measured.
 pub const WHOLE_CONES: Setting = &[("cones", "0")];
 
-const CONES: Knob = Knob {
-    name: "cones",
-    default: 1.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "0 whole cones at silhouette vertices (§2), 1 only the corner wedges between the sheets",
-};
-const OFF_PLANE: Knob = Knob {
-    name: "off_plane",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "receivers off the plane: 0 unshadowed, 1 the projected light map",
-};
+const CONES: Knob = Knob::choice(
+    "cones",
+    1.0,
+    &["whole", "wedges"],
+    "0 whole cones at silhouette vertices (§2), 1 only the corner wedges between the sheets",
+);
+const OFF_PLANE: Knob = Knob::choice(
+    "off_plane",
+    0.0,
+    &["unshadowed", "map"],
+    "receivers off the plane: 0 unshadowed, 1 the projected light map",
+);
 
 /// The plateau texture: t of the caster whose hard shadow covers the texel (or of every caster,
 /// where none does), and centred with several casters, t of other casters' outer penumbrae over

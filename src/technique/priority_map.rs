@@ -61,6 +61,7 @@ const MAP_SIZE: Knob = Knob {
     min: 16.0,
     max: 16384.0,
     integer: true,
+    choices: &[],
     help: "priority map width and height, in texels",
 };
 

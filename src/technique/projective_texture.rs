@@ -67,16 +67,15 @@ const TEXTURE_SIZE: Knob = Knob {
     min: 8.0,
     max: 4096.0,
     integer: true,
+    choices: &[],
     help: "each caster's image, texels a side (the atlas holds them all)",
 };
-const CLIP: Knob = Knob {
-    name: "clip",
-    default: 2.0,
-    min: 0.0,
-    max: 2.0,
-    integer: true,
-    help: "receivers an image falls on: 0 all it covers, 1 not behind the light, 2 nor nearer the light than the caster",
-};
+const CLIP: Knob = Knob::choice(
+    "clip",
+    2.0,
+    &["none", "behind", "between"],
+    "receivers an image falls on: 0 all it covers, 1 not behind the light, 2 nor nearer the light than the caster",
+);
 
 const IMAGE_FORMAT: vk::Format = vk::Format::R8_UNORM;
 const IMAGE_BYTES: u64 = std::mem::size_of::<CasterImage>() as u64;

@@ -59,6 +59,7 @@ const SAMPLES: Knob = Knob {
     min: 1.0,
     max: 4096.0,
     integer: true,
+    choices: &[],
     help: "points on the light, one shadow map each",
 };
 /// 2048 by default: each sample's hard edge moves by about a texel of its biases, which from a

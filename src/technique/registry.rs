@@ -132,6 +132,13 @@ mod tests {
             assert!(TECHNIQUES[..i].iter().all(|u| u.name != t.name), "{} is listed twice", t.name);
             for k in t.knobs {
                 assert!(k.min <= k.default && k.default <= k.max, "{}.{}", t.name, k.name);
+                // A name for each whole value, none of them twice or a number.
+                let names: Vec<&str> = k.choices.iter().flat_map(|c| c.split('|')).collect();
+                let whole = k.integer && k.min == 0.0 && k.max + 1.0 == k.choices.len() as f64;
+                assert!(k.choices.is_empty() || whole, "{}.{}: a name for each of 0..={}", t.name, k.name, k.max);
+                for (j, n) in names.iter().enumerate() {
+                    assert!(!names[..j].contains(n) && n.parse::<f64>().is_err(), "{}.{}: {n}", t.name, k.name);
+                }
             }
         }
     }

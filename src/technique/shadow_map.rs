@@ -68,14 +68,22 @@ pub const PCSS: TechniqueInfo = TechniqueInfo {
     error_bound: Some(APPROXIMATION_BOUND),
 };
 
-const TAPS: Knob =
-    Knob { name: "taps", default: 16.0, min: 1.0, max: 32.0, integer: true, help: "comparisons on the disk" };
+const TAPS: Knob = Knob {
+    name: "taps",
+    default: 16.0,
+    min: 1.0,
+    max: 32.0,
+    integer: true,
+    choices: &[],
+    help: "comparisons on the disk",
+};
 const RADIUS: Knob = Knob {
     name: "radius",
     default: 2.0,
     min: 0.0,
     max: 256.0,
     integer: false,
+    choices: &[],
     help: "disk radius, in texels (or world units with radius_world = 1)",
 };
 const RADIUS_WORLD: Knob =
@@ -87,16 +95,25 @@ const BLOCKER_SAMPLES: Knob = Knob {
     min: 1.0,
     max: 64.0,
     integer: true,
+    choices: &[],
     help: "taps of the blocker search",
 };
-const FILTER_SAMPLES: Knob =
-    Knob { name: "filter_samples", default: 16.0, min: 1.0, max: 64.0, integer: true, help: "taps of the PCF" };
+const FILTER_SAMPLES: Knob = Knob {
+    name: "filter_samples",
+    default: 16.0,
+    min: 1.0,
+    max: 64.0,
+    integer: true,
+    choices: &[],
+    help: "taps of the PCF",
+};
 const LIGHT_SIZE_SCALE: Knob = Knob {
     name: "light_size_scale",
     default: 1.0,
     min: 0.0,
     max: 16.0,
     integer: false,
+    choices: &[],
     help: "light size used, as a multiple of the scene light's radius",
 };
 
@@ -106,6 +123,7 @@ pub(crate) const DEPTH_BIAS: Knob = Knob {
     min: 0.0,
     max: 64.0,
     integer: false,
+    choices: &[],
     help: "constant depth bias, in shadow-map texels",
 };
 pub(crate) const SLOPE_BIAS: Knob = Knob {
@@ -114,6 +132,7 @@ pub(crate) const SLOPE_BIAS: Knob = Knob {
     min: 0.0,
     max: 64.0,
     integer: false,
+    choices: &[],
     help: "depth bias per unit tan(angle to the light), in texels",
 };
 pub(crate) const NORMAL_OFFSET: Knob = Knob {
@@ -122,6 +141,7 @@ pub(crate) const NORMAL_OFFSET: Knob = Knob {
     min: 0.0,
     max: 64.0,
     integer: false,
+    choices: &[],
     help: "lookup offset along the normal at grazing angles, in texels",
 };
 
@@ -132,6 +152,7 @@ pub const SHADOW_MAP_SIZE: Knob = Knob {
     min: 16.0,
     max: 16384.0,
     integer: true,
+    choices: &[],
     help: "shadow map width and height, in texels",
 };
 

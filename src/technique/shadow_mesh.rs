@@ -25,6 +25,7 @@ pub const SHADOW_MESH_ERROR: Knob = Knob {
     min: 0.0,
     max: 64.0,
     integer: false,
+    choices: &[],
     help: "shadows cast from a simplified caster straying at most this many texels of a 1024² light view fitted to it; 0: the full mesh",
 };
 

@@ -89,23 +89,17 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     error_bound: Some(APPROXIMATION_BOUND),
 };
 
-const COUNTING: Knob = Knob {
-    name: "counting",
-    default: 0.0,
-    min: 0.0,
-    max: 2.0,
-    integer: true,
-    help: "0: z-fail where a view ray can start in shadow, else z-pass; 1: z-pass; 2: z-fail",
-};
+const COUNTING: Knob = Knob::choice(
+    "counting",
+    0.0,
+    &["auto", "z-pass|zpass", "z-fail|zfail"],
+    "0: z-fail where a view ray can start in shadow, else z-pass; 1: z-pass; 2: z-fail",
+);
 
-const GPU_SILHOUETTES: Knob = Knob {
-    name: "gpu_silhouettes",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "1: silhouettes, volumes and caps built by a compute pass, drawn indirectly; 0: on the CPU",
-};
+const GPU_SILHOUETTES: Knob = Knob::switch(
+    "gpu_silhouettes",
+    "1: silhouettes, volumes and caps built by a compute pass, drawn indirectly; 0: on the CPU",
+);
 
 /// The stencil bits that count; the top one marks the pixels an earlier group shadowed.
 const COUNT_MASK: u32 = 0x7F;

@@ -181,6 +181,7 @@ const SMOOTHIE_SIZE: Knob = Knob {
     min: 16.0,
     max: 16384.0,
     integer: true,
+    choices: &[],
     help: "smoothie buffer width and height, in texels (the largest: see penumbra_texels)",
 };
 const T: Knob = Knob {
@@ -189,6 +190,7 @@ const T: Knob = Knob {
     min: 0.0,
     max: 1.0,
     integer: false,
+    choices: &[],
     help: "smoothie size in the light's tangent units; 0: from the light radius (t_scale R / b)",
 };
 /// The physical size by default: centred, the penumbra RMSE is least there (256², against the
@@ -200,6 +202,7 @@ const T_SCALE: Knob = Knob {
     min: 0.0,
     max: 8.0,
     integer: false,
+    choices: &[],
     help: "with t = 0: smoothie size as a multiple of the light's angular radius from the blocker",
 };
 /// Centred: what measured better. bench, 10 scenes, 512², against the reference (lavapipe, one
@@ -210,22 +213,11 @@ const CENTRED: Knob = Knob { default: 1.0, ..PENUMBRA };
 /// 256² against linear: plate 0.028 / 0.050, sphere 0.088 / 0.096, default 0.112 / 0.117,
 /// overlap 0.072 / 0.083, low_light 0.204 / 0.206.
 const SMOOTHIE_FALLOFF: Knob = Knob { default: 3.0, ..FALLOFF };
-const DEPTH16: Knob = Knob {
-    name: "depth16",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "1: the paper's 16-bit float shadow map; 0: 32-bit",
-};
-const GPU_SILHOUETTES: Knob = Knob {
-    name: "gpu_silhouettes",
-    default: 0.0,
-    min: 0.0,
-    max: 1.0,
-    integer: true,
-    help: "1: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); 0: on the CPU",
-};
+const DEPTH16: Knob = Knob::switch("depth16", "1: the paper's 16-bit float shadow map; 0: 32-bit");
+const GPU_SILHOUETTES: Knob = Knob::switch(
+    "gpu_silhouettes",
+    "1: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); 0: on the CPU",
+);
 
 /// Map and buffer sized to the narrowest smoothie: where every caster's smoothies span many
 /// texels, a coarser grid resolves them as well ([`grid::halvings`]): across a smoothie's width
@@ -272,6 +264,7 @@ const MERGE: Knob = Knob {
     min: 0.0,
     max: 16.0,
     integer: false,
+    choices: &[],
     help: "CPU path: merge silhouette chains within this many smoothie-buffer texels (position and size); 0: off",
 };
 

@@ -47,8 +47,15 @@ pub const PARKER: TechniqueInfo = TechniqueInfo {
     error_bound: None,
 };
 
-const SAMPLES: Knob =
-    Knob { name: "samples", default: 1024.0, min: 1.0, max: 65536.0, integer: true, help: "shadow rays per pixel" };
+const SAMPLES: Knob = Knob {
+    name: "samples",
+    default: 1024.0,
+    min: 1.0,
+    max: 65536.0,
+    integer: true,
+    choices: &[],
+    help: "shadow rays per pixel",
+};
 
 /// The widest half-angle a light may span from a caster for `parker`: at 84° it measured RMSE
 /// 0.45 against the tracer (tests/truths.rs), three times the hard shadow's error.
