@@ -32,10 +32,12 @@ layout(location = 0) out float out_visibility;
 
 // One texel's curve parameters. Outer only: t, 0 inside the mask. Centred, per channel (odd
 // and even casters, see penumbra.frag; one caster's in r alone): t, or −t in the channel of the
-// caster whose hard shadow covers the texel; and where either channel is umbra (s ≤ −1, V = 0
-// whatever the other says), both are. Where two casters' hard shadows abut, the channels swap
-// roles between texels (one caster's umbra beside the other's outer band), and interpolated
-// apart they drew a lit seam through the umbra (V up to 0.1 on overlap's ground).
+// caster whose hard shadow covers the texel. With two channels, where either is umbra (s ≤ −1,
+// V = 0 whatever the other says), both are: where two casters' hard shadows abut, the channels
+// swap roles between texels (one caster's umbra beside the other's outer band), and
+// interpolated apart they drew a lit seam through the umbra (V up to 0.1 on overlap's ground).
+// One channel has no such seam, and the rule would square the curve between an umbra texel and
+// its neighbour (both channels falling together).
 // `t`: the texel's plateau parameters (both channels), `caster`: its mask's caster number.
 vec2 texel_s(vec2 t, uint caster) {
     if (!CENTRED) {
@@ -43,7 +45,7 @@ vec2 texel_s(vec2 t, uint caster) {
     }
     bvec2 own = CHANNELS ? bvec2(caster % 2u == 1u, caster > 0u && caster % 2u == 0u) : bvec2(caster > 0u, false);
     vec2 s = mix(t, -t, own);
-    return min(s.x, s.y) <= -1.0 ? vec2(-1.0) : s;
+    return CHANNELS && min(s.x, s.y) <= -1.0 ? vec2(-1.0) : s;
 }
 
 // A channel's visibility: every curve maps 0 to 0 and 1 to 1, so lit and umbra channels (most
