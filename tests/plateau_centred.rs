@@ -72,6 +72,26 @@ fn a_straight_plate_edge_penumbra_straddles_the_hard_edge() {
     assert!(widths(&outer).0 <= 1.0, "outer only: {:?}", widths(&outer));
 }
 
+/// A penumbra narrower than a texel: a plate 1 m up under a light of radius 1 mm 6 m up (W =
+/// 0.4 mm at the hard edge, x = 1.2 m), seen 0.2 m across at 256², over a 16² texture (the
+/// window is the footprint seen: 12.5 mm, 16 px a texel). Between an umbra texel and its lit
+/// neighbour V is the curve once over the bilinear ramp of s, symmetric about ½ as the disk
+/// profile is (mean ½ over the ramp), not the curve squared (mean 0.41 here), which a lit second
+/// channel falling to the umbra with the first had made it.
+#[test]
+fn a_sub_texel_penumbra_ramps_once_between_texels() {
+    let s = plate(1.0, 1.0, 6.0, 0.001, 1.2, 0.1);
+    let coarse = [("texture_size", "16"), ("penumbra_texels", "0")];
+    let mut e = engine();
+    let v = row(&render_with(&mut e, &s, "plateau", &coarse, 256));
+    finish(e);
+    let ramp: Vec<f32> = v.iter().copied().filter(|v| (0.02..=0.98).contains(v)).collect();
+    assert!(ramp.len() >= 8, "a texel's ramp across {} px: {v:?}", ramp.len());
+    assert!(v.windows(2).all(|w| w[1] >= w[0] - 1e-3), "V rises across the edge: {v:?}");
+    let mean = ramp.iter().sum::<f32>() / ramp.len() as f32;
+    assert!((mean - 0.5).abs() <= 0.05, "mean V {mean} over the ramp: {ramp:?}");
+}
+
 /// A plate's corner (common::plate_corner): its hard shadow's corner sees the light cut by both
 /// edges' lines, ¾ of it, where either sheet alone says ½, and around it the sides follow the
 /// reference within 0.06.
