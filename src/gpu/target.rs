@@ -154,21 +154,21 @@ impl Target {
             target.destroy(ctx);
             return Err(Error::Vulkan { call: "vkBindImageMemory", result });
         }
-        let views = create_view(ctx, image, &desc).and_then(|v| {
-            target.view = v;
-            desc.reinterpreted.map_or(Ok(vk::ImageView::null()), |format| {
-                view_of(ctx, image, &TargetDesc { format, ..desc }, desc.aspect())
-            })
-        });
-        match views {
-            Ok(v) => target.reinterpreted = v,
-            Err(e) => {
-                target.destroy(ctx);
-                return Err(e);
-            }
+        if let Err(e) = target.create_views(ctx) {
+            target.destroy(ctx);
+            return Err(e);
         }
         ctx.name(image, desc.name);
         Ok(target)
+    }
+
+    /// The view of `desc`, and the view of its reinterpreted format where it has one.
+    fn create_views(&mut self, ctx: &Context) -> Result<()> {
+        self.view = create_view(ctx, self.image, &self.desc)?;
+        if let Some(format) = self.desc.reinterpreted {
+            self.reinterpreted = view_of(ctx, self.image, &TargetDesc { format, ..self.desc }, self.desc.aspect())?;
+        }
+        Ok(())
     }
 
     /// Wraps an image created elsewhere (a swapchain image, the embedder's depth buffer) of

@@ -201,7 +201,7 @@ const SIZE_MODE: Knob = Knob::choice(
     "size_mode",
     0.0,
     &["physical", "haines"],
-    "0: penumbra from the light sphere; 1: Haines' constant factor times height",
+    "physical: penumbra from the light sphere; haines: Haines' constant factor times height",
 );
 const PENUMBRA_SCALE: Knob = Knob {
     name: "penumbra_scale",
@@ -219,13 +219,13 @@ const HAINES_FACTOR: Knob = Knob {
     max: 10.0,
     integer: false,
     choices: &[],
-    help: "size_mode 1: cone radius per unit of height (Haines used 0.1)",
+    help: "size_mode=haines: cone radius per unit of height (Haines used 0.1)",
 };
 const EDGES: Knob = Knob::choice(
     "edges",
     0.0,
     &["outline", "polygons"],
-    "0 the shadow's outline (silhouettes, and an open mesh's boundary edges), 1 every light-facing polygon (§3)",
+    "outline: the shadow's outline (silhouettes, and an open mesh's boundary edges); polygons: every light-facing polygon (§3)",
 );
 /// Whole cones as Haines drew them (§2), against which the corner wedges are measured.
 pub const WHOLE_CONES: Setting = &[("cones", "0")];
@@ -234,13 +234,13 @@ const CONES: Knob = Knob::choice(
     "cones",
     1.0,
     &["whole", "wedges"],
-    "0 whole cones at silhouette vertices (§2), 1 only the corner wedges between the sheets",
+    "whole: cones at silhouette vertices (§2); wedges: only their corner wedges between the sheets",
 );
 const OFF_PLANE: Knob = Knob::choice(
     "off_plane",
     0.0,
     &["unshadowed", "map"],
-    "receivers off the plane: 0 unshadowed, 1 the projected light map",
+    "receivers off the plane: unshadowed, or map: the projected light map",
 );
 
 /// The plateau texture: t of the caster whose hard shadow covers the texel (or of every caster,

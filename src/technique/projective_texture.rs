@@ -74,7 +74,7 @@ const CLIP: Knob = Knob::choice(
     "clip",
     2.0,
     &["none", "behind", "between"],
-    "receivers an image falls on: 0 all it covers, 1 not behind the light, 2 nor nearer the light than the caster",
+    "receivers an image falls on: none clipped, behind: none behind the light, between: nor nearer the light than the caster",
 );
 
 const IMAGE_FORMAT: vk::Format = vk::Format::R8_UNORM;

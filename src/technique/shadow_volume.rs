@@ -93,7 +93,7 @@ const COUNTING: Knob = Knob::choice(
     "counting",
     0.0,
     &["auto", "z-pass|zpass", "z-fail|zfail"],
-    "0: z-fail where a view ray can start in shadow, else z-pass; 1: z-pass; 2: z-fail",
+    "auto: z-fail where a view ray can start in shadow, else z-pass; or always z-pass, or z-fail",
 );
 
 const GPU_SILHOUETTES: Knob = Knob::switch(
