@@ -4,7 +4,7 @@
 //! (wingnut, 6090 triangles) and at scale (koala, 99 994 triangles, issue 18). No vertex is
 //! transformed: the volumes are vertex numbers, drawn from the object-space positions. The GPU
 //! path does the same in its `silhouettes` compute pass
-//! (`softshadow render --set gpu_silhouettes=1 --timings`).
+//! (`softshadow render --set gpu_silhouettes=on --timings`).
 
 use std::path::Path;
 

@@ -172,7 +172,7 @@ pub type ScenePair<'a> = (&'a str, &'a BenchRow, &'a BenchRow);
 
 impl Goal {
     /// The goal as a column heading, e.g. `smoothie / shadow-map shadow_map_size=1024 ≤ 1.3`
-    /// or `plateau leaks ≤ plateau penumbra=0 falloff=0`.
+    /// or `plateau leaks ≤ plateau penumbra=outer falloff=linear`.
     pub fn label(&self) -> String {
         let side = |t: &str, s: &str| if s.is_empty() { t.to_string() } else { format!("{t} {s}") };
         let (of, base) = (side(self.technique, &self.setting), side(self.baseline, &self.baseline_setting));
@@ -624,7 +624,7 @@ mod tests {
             metrics: Metrics { leak_rate, dark_rate: 0.5 * leak_rate, pixels: 10_000, ..Default::default() },
             ..row(scene, "plateau", setting, 1.0)
         };
-        let outer = "penumbra=0 falloff=0";
+        let outer = "penumbra=outer falloff=linear";
         let rows = [
             leaking("a", "", 0.0),
             leaking("a", outer, 0.0),
@@ -636,7 +636,10 @@ mod tests {
         let plateau = leak_goals().into_iter().find(|g| g.technique == "plateau").expect("the plateau's leak rule");
         assert_eq!((plateau.baseline, plateau.baseline_setting.as_str()), ("plateau", outer));
         // Equal rates (none at all, say) meet it; a higher one does not.
-        assert_eq!(plateau.outcome(&rows).unwrap(), "plateau leaks ≤ plateau penumbra=0 falloff=0: met on 2/3 scenes");
+        assert_eq!(
+            plateau.outcome(&rows).unwrap(),
+            "plateau leaks ≤ plateau penumbra=outer falloff=linear: met on 2/3 scenes"
+        );
         let table = goal_table(LEAK_HEADING, vec![plateau], &rows);
         for line in ["| a | 0 vs 0 px ✓ (darker: 0 vs 0) |", "| b | 20 vs 10 px ✗ (darker: 10 vs 5) |", "| met | 2/3 |"]
         {

@@ -42,7 +42,7 @@ impl Knob {
     }
 
     /// The value a name of `choices` stands for.
-    fn named(&self, name: &str) -> Option<f64> {
+    pub(crate) fn named(&self, name: &str) -> Option<f64> {
         let name = name.trim();
         self.choices.iter().position(|c| c.split('|').any(|n| n.eq_ignore_ascii_case(name))).map(|i| i as f64)
     }

@@ -164,10 +164,10 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 
 /// The paper's form at its best curve (linear: the outer half starts at the hard edge, where the
 /// truth is already ½, and the other curves stay darker longer), at the physical size.
-pub const OUTER_ONLY: Setting = &[("penumbra", "0"), ("falloff", "0")];
+pub const OUTER_ONLY: Setting = &[("penumbra", "outer"), ("falloff", "linear")];
 /// The paper's form at the narrow cones it measured best with before issue 20 (0.4 of the half
 /// width: wider only darkens more of the outer half).
-pub const OUTER_ONLY_NARROW: Setting = &[("penumbra", "0"), ("falloff", "0"), ("penumbra_scale", "0.4")];
+pub const OUTER_ONLY_NARROW: Setting = &[("penumbra", "outer"), ("falloff", "linear"), ("penumbra_scale", "0.4")];
 
 /// Centred by default: over the suite (bench, 10 scenes, 512², lavapipe, against the reference,
 /// one run) its median penumbra RMSE is 0.030, against 0.312 for the outer-only form at the
@@ -228,7 +228,7 @@ const EDGES: Knob = Knob::choice(
     "outline: the shadow's outline (silhouettes, and an open mesh's boundary edges); polygons: every light-facing polygon (§3)",
 );
 /// Whole cones as Haines drew them (§2), against which the corner wedges are measured.
-pub const WHOLE_CONES: Setting = &[("cones", "0")];
+pub const WHOLE_CONES: Setting = &[("cones", "whole")];
 
 const CONES: Knob = Knob::choice(
     "cones",

@@ -47,7 +47,7 @@ pub const PCF: TechniqueInfo = TechniqueInfo {
     kind: Kind::Realtime,
     knobs: &[SHADOW_MAP_SIZE, DEPTH_BIAS, SLOPE_BIAS, NORMAL_OFFSET, TAPS, RADIUS, RADIUS_WORLD, BICUBIC],
     create: ShadowMap::create,
-    bench: &[&[("taps", "16")], &[("taps", "4")], &[("taps", "32")], &[("bicubic", "1")]],
+    bench: &[&[("taps", "16")], &[("taps", "4")], &[("taps", "32")], &[("bicubic", "on")]],
     sweep_knobs: SweepKnobs::DEFAULTS,
     cost_goal: None,
     receivers: Receivers::All,

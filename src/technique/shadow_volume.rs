@@ -78,8 +78,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create: |ctx, _, visibility| Ok(Box::new(ShadowVolumes::new(ctx, visibility)?)),
     bench: &[
         &[],
-        &[("counting", "2")],
-        &[("gpu_silhouettes", "1")],
+        &[("counting", "z-fail")],
+        &[("gpu_silhouettes", "on")],
         &[("samples", "16")],
         &[("shadow_mesh_error", "1")],
     ],

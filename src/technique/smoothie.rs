@@ -140,8 +140,8 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     bench: &[
         &[],
         OUTER_ONLY,
-        &[("depth16", "1")],
-        &[("gpu_silhouettes", "1")],
+        &[("depth16", "on")],
+        &[("gpu_silhouettes", "on")],
         &[("shadow_mesh_error", "0")],
         &[("merge", "1")],
         QUARTER_TEXELS,
@@ -160,7 +160,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 
 /// The papers' form at its best-measured curve (linear: see [`FALLOFF`]), for bench's rows and
 /// cost goals.
-pub const OUTER_ONLY: Setting = &[("penumbra", "0"), ("falloff", "0")];
+pub const OUTER_ONLY: Setting = &[("penumbra", "outer"), ("falloff", "linear")];
 
 /// The map and the smoothie buffer at half the default width whatever the penumbrae: a quarter
 /// of their texels, for bench's row of the trade.
