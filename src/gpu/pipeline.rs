@@ -468,8 +468,8 @@ impl Pipeline {
             match (b.kind, input) {
                 (Binding::Uniform | Binding::Storage, Descriptor::Buffer(info)) => buffers.push([*info]),
                 (Binding::Sampled, &Descriptor::Image(t)) => images.push(sampled(t, t.view)),
-                (Binding::Sampled, &Descriptor::Reinterpreted(t)) if t.reinterpreted != vk::ImageView::null() => {
-                    images.push(sampled(t, t.reinterpreted))
+                (Binding::Sampled, &Descriptor::Reinterpreted(t)) if let Some(view) = t.reinterpreted => {
+                    images.push(sampled(t, view))
                 }
                 (Binding::Sampled, Descriptor::Reinterpreted(t)) => {
                     return Err(mismatch(format!(
@@ -648,7 +648,7 @@ mod tests {
         assert!(e.contains("binding 2 `camera_depth`") && e.contains("`plain` reinterpreted"), "{e}");
         let packed = TargetDesc::color("packed", vk::Format::R16G16_UNORM, 4, 4).reinterpreted_as(vk::Format::R32_UINT);
         let packed = Target::new(&ctx, packed).unwrap();
-        assert_ne!(packed.reinterpreted, vk::ImageView::null());
+        assert!(packed.reinterpreted.is_some());
         plain.destroy(&ctx);
         packed.destroy(&ctx);
         unsafe { ctx.device.destroy_command_pool(pool, ctx.host_allocator()) };

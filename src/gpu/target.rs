@@ -96,8 +96,8 @@ pub struct Target {
     pub desc: TargetDesc,
     pub(crate) image: vk::Image,
     pub(crate) view: vk::ImageView,
-    /// The view of `desc.reinterpreted`, null without one.
-    pub(crate) reinterpreted: vk::ImageView,
+    /// The view of `desc.reinterpreted`, where the target made one.
+    pub(crate) reinterpreted: Option<vk::ImageView>,
     allocation: Option<Allocation>,
     owns: Owns,
     pub(crate) last: Access,
@@ -137,7 +137,7 @@ impl Target {
             desc,
             image,
             view: vk::ImageView::null(),
-            reinterpreted: vk::ImageView::null(),
+            reinterpreted: None,
             allocation: None,
             owns: Owns::Everything,
             last: Access::NONE,
@@ -166,7 +166,8 @@ impl Target {
     fn create_views(&mut self, ctx: &Context) -> Result<()> {
         self.view = create_view(ctx, self.image, &self.desc)?;
         if let Some(format) = self.desc.reinterpreted {
-            self.reinterpreted = view_of(ctx, self.image, &TargetDesc { format, ..self.desc }, self.desc.aspect())?;
+            let desc = TargetDesc { format, ..self.desc };
+            self.reinterpreted = Some(view_of(ctx, self.image, &desc, self.desc.aspect())?);
         }
         Ok(())
     }
@@ -186,8 +187,7 @@ impl Target {
             Some(v) => (v, Owns::Nothing),
             None => (create_view(ctx, image, &desc)?, Owns::View),
         };
-        let reinterpreted = vk::ImageView::null();
-        Ok(Target { desc, image, view, reinterpreted, allocation: None, owns, last: current })
+        Ok(Target { desc, image, view, reinterpreted: None, allocation: None, owns, last: current })
     }
 
     /// [`Target::wrap`] for an image that passes only sample (the embedder's depth): the view
@@ -198,8 +198,7 @@ impl Target {
         let aspect = desc.aspect();
         let sampled = if aspect.contains(vk::ImageAspectFlags::DEPTH) { vk::ImageAspectFlags::DEPTH } else { aspect };
         let view = view_of(ctx, image, &desc, sampled)?;
-        let reinterpreted = vk::ImageView::null();
-        Ok(Target { desc, image, view, reinterpreted, allocation: None, owns: Owns::View, last: current })
+        Ok(Target { desc, image, view, reinterpreted: None, allocation: None, owns: Owns::View, last: current })
     }
 
     /// The image (ours or wrapped), for an embedder to read what the engine wrote.
@@ -250,7 +249,9 @@ impl Target {
         unsafe {
             if self.owns != Owns::Nothing {
                 ctx.device.destroy_image_view(self.view, ctx.host_allocator());
-                ctx.device.destroy_image_view(self.reinterpreted, ctx.host_allocator());
+                if let Some(view) = self.reinterpreted {
+                    ctx.device.destroy_image_view(view, ctx.host_allocator());
+                }
             }
             if self.owns == Owns::Everything {
                 ctx.device.destroy_image(self.image, ctx.host_allocator());

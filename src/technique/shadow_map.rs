@@ -87,8 +87,8 @@ const RADIUS: Knob = Knob {
     help: "disk radius, in texels (or world units with radius_world = 1)",
 };
 const RADIUS_WORLD: Knob =
-    Knob::switch("radius_world", "1: radius in world units at the receiver; 0: in shadow-map texels");
-const BICUBIC: Knob = Knob::switch("bicubic", "1: a 4x4 bicubic B-spline footprint instead of the disk");
+    Knob::switch("radius_world", "on: radius in world units at the receiver; off: in shadow-map texels");
+const BICUBIC: Knob = Knob::switch("bicubic", "on: a 4x4 bicubic B-spline footprint instead of the disk");
 const BLOCKER_SAMPLES: Knob = Knob {
     name: "blocker_samples",
     default: 16.0,

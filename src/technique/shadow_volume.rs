@@ -98,7 +98,7 @@ const COUNTING: Knob = Knob::choice(
 
 const GPU_SILHOUETTES: Knob = Knob::switch(
     "gpu_silhouettes",
-    "1: silhouettes, volumes and caps built by a compute pass, drawn indirectly; 0: on the CPU",
+    "on: silhouettes, volumes and caps built by a compute pass, drawn indirectly; off: on the CPU",
 );
 
 /// The stencil bits that count; the top one marks the pixels an earlier group shadowed.

@@ -213,10 +213,10 @@ const CENTRED: Knob = Knob { default: 1.0, ..PENUMBRA };
 /// 256² against linear: plate 0.028 / 0.050, sphere 0.088 / 0.096, default 0.112 / 0.117,
 /// overlap 0.072 / 0.083, low_light 0.204 / 0.206.
 const SMOOTHIE_FALLOFF: Knob = Knob { default: 3.0, ..FALLOFF };
-const DEPTH16: Knob = Knob::switch("depth16", "1: the paper's 16-bit float shadow map; 0: 32-bit");
+const DEPTH16: Knob = Knob::switch("depth16", "on: the paper's 16-bit float shadow map; off: 32-bit");
 const GPU_SILHOUETTES: Knob = Knob::switch(
     "gpu_silhouettes",
-    "1: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); 0: on the CPU",
+    "on: silhouettes and smoothies in a compute shader, drawn indirectly (every edge: no merge); off: on the CPU",
 );
 
 /// Map and buffer sized to the narrowest smoothie: where every caster's smoothies span many
