@@ -47,6 +47,16 @@ impl Knob {
         self.choices.iter().position(|c| c.split('|').any(|n| n.eq_ignore_ascii_case(name))).map(|i| i as f64)
     }
 
+    /// `value` as `--set` and scene files take it: the name of a named choice (its first
+    /// spelling), else the number.
+    pub fn show(&self, value: f64) -> String {
+        let index = (value.fract() == 0.0 && value >= 0.0).then_some(value as usize);
+        match index.and_then(|i| self.choices.get(i)) {
+            Some(choice) => choice.split('|').next().unwrap_or_default().to_string(),
+            None => value.to_string(),
+        }
+    }
+
     /// `choices` for a listing: `0 outer, 1 centred`, a name's first spelling only.
     pub fn choice_list(&self) -> String {
         let first = |c: &&str| c.split('|').next().unwrap_or_default().to_string();
@@ -116,11 +126,12 @@ impl Params {
     }
 }
 
-/// `name=value` for every knob, in declaration order.
+/// `name=value` for every knob, in declaration order, each value as [`Knob::show`] gives it:
+/// what `--set` takes back.
 impl std::fmt::Display for Params {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let pairs: Vec<_> =
-            self.technique.knobs.iter().map(|k| format!("{}={}", k.name, self.values[k.name])).collect();
+            self.technique.knobs.iter().map(|k| format!("{}={}", k.name, k.show(self.values[k.name]))).collect();
         f.write_str(&pairs.join(" "))
     }
 }
@@ -163,5 +174,24 @@ mod tests {
         let e = p.set("penumbra_scale", "wide").unwrap_err().to_string();
         assert!(e.ends_with("is not a number"), "{e}");
         assert_eq!(penumbra.choice_list(), "0 outer, 1 centred");
+    }
+
+    /// What compare, render's timings and the window print of the knobs names their values as
+    /// `--set` takes them, and reads back as the same values, for every technique.
+    #[test]
+    fn shown_knobs_name_their_values_and_read_back() {
+        let mut p = Params::defaults(find("plateau").unwrap());
+        p.apply([("penumbra", "outer"), ("falloff", "linear"), ("penumbra_scale", "0.4")]).unwrap();
+        let shown = p.to_string();
+        for pair in ["penumbra=outer", "falloff=linear", "penumbra_scale=0.4", "texture_size=1024"] {
+            assert!(shown.split(' ').any(|s| s == pair), "{pair} in {shown}");
+        }
+        for &technique in crate::technique::TECHNIQUES {
+            let p = Params::defaults(technique);
+            let mut back = Params::defaults(technique);
+            back.apply(p.to_string().split(' ').filter_map(|pair| pair.split_once('='))).unwrap();
+            assert_eq!(back.to_string(), p.to_string(), "{}", technique.name);
+            assert!(technique.knobs.iter().all(|k| back.get(k) == p.get(k)), "{}", technique.name);
+        }
     }
 }

@@ -284,7 +284,8 @@ fn title(engine: &Engine, params: &Params, frames: &[FrameTimings]) -> String {
     let stats = engine.window_stats();
     let (w, h) = stats.map_or((0, 0), |s| (s.width, s.height));
     let r = TimingReport::new(engine.device(), params.technique.name, w, h, frames);
-    let knob = params.technique.knobs.first().map_or(String::new(), |k| format!(" {}={}", k.name, params.get(k)));
+    let knob =
+        params.technique.knobs.first().map_or(String::new(), |k| format!(" {}={}", k.name, k.show(params.get(k))));
     let passes: Vec<String> = r.passes.iter().map(|p| format!("{} {:.2}", p.name, p.gpu_ms_median)).collect();
     format!("{}{knob}: {:.2} GPU ms ({}) {w}x{h}", params.technique.name, r.gpu_ms_total_median, passes.join(", "))
 }
