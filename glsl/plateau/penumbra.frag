@@ -22,9 +22,14 @@ layout(constant_id = 0) const bool CENTRED = false;
 layout(constant_id = 1) const bool OVERLAPS = true;
 // Sheets or wedges (see penumbra.vert for what each interpolates).
 layout(constant_id = 2) const bool SHEETS = false;
-// Centred, the outer halves of partial silhouettes (geometry::plateau::partial_sides): their
-// hard edges lie inside the hard shadow, so they write only where the mask is lit.
-layout(constant_id = 3) const bool PARTIAL = false;
+// Centred, partial silhouettes' sheets (geometry::plateau::partial_sides), whose hard edges lie
+// inside the hard shadow: 1, the outer halves of those above the silhouette, which write only
+// where the mask is lit; 2, the inner halves of those below it, which write only where it holds
+// their own caster, blended by max (0 in the other channel leaves it as it is), so that they
+// only darken. 0: the silhouette's sides.
+layout(constant_id = 3) const uint PARTIAL = 0u;
+#define PARTIAL_OUTER 1u
+#define PARTIAL_INNER 2u
 // Centred, the sides near the hard shadow's corners (corners.glsl), drawn apart from the rest.
 layout(constant_id = 4) const bool CORNERS = false;
 
@@ -165,14 +170,36 @@ float with_corner(float t, float side, float gain, bool own) {
 }
 
 // Centred: whether this side writes here (its foot on the hard shadow's boundary, or an
-// outer band over another caster's hard shadow) and what, per channel.
-bool centred_t(float t, float s, out vec2 written) {
+// outer band over another caster's hard shadow) and what, per channel. `texel`: the texel's
+// size in plane units.
+bool centred_t(float t, float s, vec2 texel, out vec2 written) {
     written = vec2(1.0);
-    if (PARTIAL) {
+    if (PARTIAL == PARTIAL_OUTER) {
         if (caster_at(gl_FragCoord.xy) != 0u) {
             return false;
         }
         written = in_channel(in_caster, t);
+        return true;
+    }
+    if (PARTIAL == PARTIAL_INNER) {
+        // Drawn k = |normal| times its width, the umbra held beyond (partial_sides).
+        float k = length(in_turns.xy);
+        // The edge's half plane hides no more than its caster where the caster reaches a whole
+        // width of the edge's penumbra further in, and as far to either side: its hard shadow
+        // covers those points (the width along its tangent from here, turned ±45°). Where it
+        // does not, the caster is narrower than the penumbra, or turns a corner within it, and
+        // the silhouette's sheets, nearest edge and corners, say more: the hammer's thin handle
+        // went 0.13 too dark across its shadow without the first, default's wingnut 0.13 beside
+        // a corner without the others.
+        vec2 width = (in_shape0.zw + s * (in_shape1.xy - in_shape0.xy - in_shape0.zw)) / k / texel;
+        vec2 side = vec2(-width.y, width.x);
+        vec2 here = gl_FragCoord.xy;
+        if (caster_at(here) != in_caster || caster_at(here + width) != in_caster
+            || caster_at(here + width + side) != in_caster || caster_at(here + width - side) != in_caster) {
+            return false;
+        }
+        float held = min(t * k, 1.0);
+        written = mix(vec2(held), vec2(-1.0), in_channel(in_caster, 0.0)); // the other channel stored 0
         return true;
     }
     uint here = OVERLAPS ? caster_at(gl_FragCoord.xy) : 0u;
@@ -236,7 +263,7 @@ void main() {
     }
     vec2 written = vec2(t, 1.0);
     if (CENTRED) {
-        if (!centred_t(t, s, written)) {
+        if (!centred_t(t, s, texel, written)) {
             discard;
         }
     }

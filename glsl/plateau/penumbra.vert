@@ -20,7 +20,8 @@
 layout(constant_id = 0) const bool CENTRED = false;
 // Sheets (6 vertices a primitive) or wedges (9).
 layout(constant_id = 2) const bool SHEETS = false;
-layout(constant_id = 3) const bool PARTIAL = false;
+// As penumbra.frag's: partial silhouettes' sheets (1, 2), which have no probes.
+layout(constant_id = 3) const uint PARTIAL = 0u;
 // As penumbra.frag's: the sides near corners.
 layout(constant_id = 4) const bool CORNERS = false;
 
@@ -119,7 +120,7 @@ void main() {
             out_corner0.zw *= float(corner_holds(r3.xy, r2.xy, r3.zw, out_turns.z > 0.5));
             out_corner1.zw *= float(corner_holds(r5.xy, r2.xy, r5.zw, out_turns.w > 0.5));
         }
-        if (CENTRED && !PARTIAL) {
+        if (CENTRED && PARTIAL == 0u) {
             SheetProbes probed = probes[primitive - plateau.sheets.x];
             out_probes = probed.bits;
             out_samples = probed.samples.x;

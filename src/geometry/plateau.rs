@@ -13,8 +13,9 @@
 //! which gives the distance its sign. Each vertex carries the silhouette point it measures from
 //! (its foot) and the edge's normal, so the GPU can drop the distances to silhouettes that do
 //! not lie on the hard shadow's boundary (interior folds, edges under another caster's shadow).
-//! [`partial_sides`] adds the outer halves of edges that are the silhouette for part of the
-//! light only ([`caster_sides`] puts a caster's together).
+//! [`partial_sides`] adds the sheets of edges that are the silhouette for part of the light
+//! only: outer halves that widen the silhouette's, inner halves that narrow it ([`caster_sides`]
+//! puts a caster's together).
 
 use glam::{Mat2, Mat4, Vec2, Vec3, Vec4};
 
@@ -283,6 +284,8 @@ pub struct Sheet {
     pub b: [f32; 2],
     pub ta: [f32; 2],
     pub tb: [f32; 2],
+    /// The edge's unit normal; a partial silhouette's inward sheet's is k times it, the sheet
+    /// drawn k times its width, its umbra held past it ([`partial_sides`]).
     pub normal: [f32; 2],
     pub caster: f32,
     /// The hull as two triangles: six corner numbers of 2 bits, the first lowest (0 a, 1 b,
@@ -510,9 +513,12 @@ impl Wedge {
 pub struct PlateauGeometry {
     pub cones: Vec<Wedge>,
     pub sheets: Vec<Sheet>,
-    /// Centred, the outer halves of partial silhouettes ([`partial_sides`]): drawn only where
-    /// the hard shadow is lit.
+    /// Centred, the outer halves of partial silhouettes above the silhouette ([`partial_sides`]):
+    /// drawn only where the hard shadow is lit.
     pub partial: Vec<Sheet>,
+    /// Centred, the inner halves of partial silhouettes below it ([`partial_sides`]): drawn
+    /// only over their own caster's hard shadow, blended by max.
+    pub partial_inner: Vec<Sheet>,
     /// Plane-space bounds of the shadow: the projected caster (the umbra, even when the
     /// penumbra has no width) and every cone and sheet.
     pub footprint: Option<(Vec2, Vec2)>,
@@ -529,6 +535,7 @@ impl PlateauGeometry {
         self.cones.extend_from_slice(&other.cones);
         self.sheets.extend_from_slice(&other.sheets);
         self.partial.extend_from_slice(&other.partial);
+        self.partial_inner.extend_from_slice(&other.partial_inner);
         if let Some((lo, hi)) = other.footprint {
             self.grow(lo);
             self.grow(hi);
@@ -844,16 +851,29 @@ fn outward(ca: &Cone, cb: &Cone, inside: Vec2) -> Vec2 {
     across.try_normalize().unwrap_or(along.perp())
 }
 
-/// Centred, the outer halves of one caster's partial silhouettes (`edges`, from
-/// [`partial_silhouettes`]), numbered `number`: a sheet on each edge's outer side (away from
-/// its inner vertex), sized by its own cones, where it reaches [`PARTIAL_GAIN`] past what the
-/// silhouette from the centre casts. Their hard edges lie inside the hard shadow, where a face
-/// seen nearly edge-on from the light's centre projects to a sliver beside the silhouette's, so
-/// the GPU draws them only where the hard shadow is lit, and they only darken: there t is the
-/// distance from the edge in its half widths, which near the silhouette exceeds the
-/// silhouette's own and further out, where the wider penumbra of a higher edge still reaches,
-/// is the smaller. Outer only, nothing: the paper's penumbra already spans the whole width
-/// outward. No cones at their ends: the silhouette's cover the shadow's corners.
+/// Centred, the sheets of one caster's partial silhouettes (`edges`, from
+/// [`partial_silhouettes`]), numbered `number`, each on the side away from its inner vertex and
+/// sized by its own cones, where it gains [`PARTIAL_GAIN`] of its half width on what the
+/// silhouette from the centre casts (about: the cone of the turned face's far vertex). Their
+/// hard edges lie inside the hard shadow, where a face seen nearly edge-on from the light's
+/// centre projects to a sliver beside the silhouette's. No cones at their ends: the silhouette's
+/// cover the shadow's corners. Outer only, nothing: the paper's penumbra spans the whole width
+/// outward, and its umbra the whole hard shadow.
+///
+/// - An edge whose faces the centre sees lit lies above the silhouette, nearer the light: for
+///   the part of the light behind its turned face it is the silhouette, with the wider penumbra.
+///   Its sheet runs outward, and goes to `partial`, drawn only where the hard shadow is lit,
+///   where it darkens only: t is its distance from the edge in its half widths, which near the
+///   silhouette exceeds the silhouette's own and further out, where the wider penumbra still
+///   reaches, is the smaller (`low_light`'s box).
+/// - An edge whose faces the centre sees unlit lies below it, nearer the receiver: for the part
+///   of the light in front of its turned face, the part a receiver inside the hard shadow still
+///   sees, it is the silhouette, with the narrower penumbra. Its sheet runs inward and goes to
+///   `partial_inner`, drawn only over its own caster's hard shadow and blended by max, so that
+///   it only darkens there too. Each edge's half plane lets through at least what the caster
+///   does, so the darkest of them is the nearest to the truth: a thick slab's inner half spans
+///   the way from its top rim's hard edge to its bottom rim's umbra, narrower than the top
+///   rim's alone.
 ///
 /// [`partial_silhouettes`]: super::silhouette::partial_silhouettes
 pub fn partial_sides(
@@ -870,8 +890,9 @@ pub fn partial_sides(
     }
     let world = |v: u32| model.transform_point3(caster.positions[v as usize]);
     // A fine mesh has thousands of partial silhouettes, nearly all of them dropped: each vertex's
-    // cone once, and the tangents only where the cones' reach leaves room for a gain (the
-    // tangent's reach is at most the farther cone's).
+    // cone once, and an outward sheet's tangent only where the cones' reach leaves room for a
+    // gain (the tangent's reach is at most the farther cone's); an inward sheet's tangent may
+    // reach less than either cone, so it is always found.
     let mut vertices: Vec<u32> = edges.iter().flat_map(|e| [e.vertices[0], e.vertices[1], e.turned]).collect();
     vertices.sort_unstable();
     vertices.dedup();
@@ -884,25 +905,54 @@ pub fn partial_sides(
             let [a, b] = edge.vertices;
             let (ca, cb, cc) = (cone(a)?, cone(b)?, cone(edge.turned)?);
             let normal = outward(&ca, &cb, plane.project(light.position, world(edge.inner))?);
+            // How far the turned vertex's cone reaches along the normal, and by how much the
+            // edge's sheet, reaching `reach`, passes it: outward (lit) or short of it (unlit).
             let beyond = cc.support(normal);
-            let gain = |reach: f32, half: f32| reach - beyond > PARTIAL_GAIN * half;
+            let gain = |reach: f32, half: f32| {
+                let past = if edge.lit { reach - beyond } else { beyond - reach };
+                past > PARTIAL_GAIN * half
+            };
             let half = |c: &Cone| c.support(normal) - normal.dot(c.centre);
-            if !gain(ca.support(normal).max(cb.support(normal)), half(&ca).max(half(&cb))) {
+            if edge.lit && !gain(ca.support(normal).max(cb.support(normal)), half(&ca).max(half(&cb))) {
                 return None;
             }
             let (ta, tb) = outer_tangent(&ca, &cb, normal)?;
-            let reach = normal.dot(ta).max(normal.dot(tb));
-            gain(reach, (ta - ca.centre).dot(normal).max((tb - cb.centre).dot(normal)))
-                .then_some((ca.centre, cb.centre, ta, tb, normal))
+            let [ra, rb] = [ta, tb].map(|t| normal.dot(t));
+            let reach = if edge.lit { ra.max(rb) } else { ra.min(rb) };
+            let widths = [(ta - ca.centre).dot(normal), (tb - cb.centre).dot(normal)];
+            if !gain(reach, widths[0].max(widths[1])) {
+                return None;
+            }
+            if edge.lit {
+                return Some((ca.centre, cb.centre, ta, tb, normal, true));
+            }
+            // Past its umbra the edge still hides the whole light, as far as the silhouette's
+            // inner half reaches (about `beyond`): the sheet drawn `k` times as wide, t scaled
+            // back by k and held at 1 there, k in the normal's length (penumbra.frag).
+            let k = [(ca.centre, widths[0]), (cb.centre, widths[1])]
+                .map(|(c, w)| (beyond - normal.dot(c)) / w)
+                .into_iter()
+                .fold(1.0, f32::max)
+                .min(MAX_INNER_REACH);
+            let (a, b) = (ca.centre, cb.centre);
+            Some((a, b, a + (ta - a) * k, b + (tb - b) * k, normal * k, false))
         })
         .collect();
-    for (a, b, ta, tb, normal) in sheets {
+    for (a, b, ta, tb, normal, lit) in sheets {
         if let Some(sheet) = out.sheet(a, b, ta, tb, normal, number) {
-            out.partial.push(sheet);
+            if lit {
+                out.partial.push(sheet)
+            } else {
+                out.partial_inner.push(sheet)
+            };
         }
     }
     out
 }
+
+/// How many times its own width an inward partial silhouette's sheet may reach ([`partial_sides`]):
+/// an edge at contact has none, and its umbra begins on its hard edge.
+const MAX_INNER_REACH: f32 = 64.0;
 
 /// The parts of a vertex's cone that none of the sheets there cover (`covered`: sectors from
 /// the apex, see [`Covers`]), into `out`; `scratch`: reused arc lists.
@@ -1420,6 +1470,48 @@ mod tests {
         let g = sides(&light, &caster, &tilted, 1.0);
         assert!(g.narrowest_half_width() < 1e-4, "touching the ground: {}", g.narrowest_half_width());
         assert_eq!(PlateauGeometry::default().narrowest_half_width(), f32::INFINITY);
+    }
+
+    /// A thick slab (0.6 m wide, 1.3 m tall from 1 m up, 4 m long) under a light of radius
+    /// 0.5 m 5 m straight above it: the sides' bottom rims, unlit from the centre and lit from
+    /// the light's rim, are its partial silhouettes, and centred, their inner halves go inward
+    /// from x = ±0.375 m (0.3·5/4) to their own umbra at ±0.25 m (half width 0.5·1/4), held to
+    /// where the top rims' inner halves end, ±(0.556 − 0.426) m: k = 1.96. Outer only, none.
+    #[test]
+    fn a_thick_slab_s_bottom_rims_narrow_its_inner_halves() {
+        let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(0.6, 1.3, 4.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
+        let planes = FacePlanes::new(&slab, &triangles);
+        let model = Mat4::from_translation(Vec3::Y * 1.65);
+        let at = |penumbra| {
+            let light = PlateauLight {
+                position: Vec3::Y * 5.0,
+                radius: 0.5,
+                size: PenumbraSize::Physical { scale: 1.0 },
+                penumbra,
+                wedges: true,
+            };
+            let ground = ReceiverPlane::ground(0.0);
+            caster_sides(&ground, &light, (&caster, &planes), &model, EdgeSource::Silhouettes, 2.0)
+        };
+        let outer = at(Penumbra::Outer);
+        assert!(outer.partial.is_empty() && outer.partial_inner.is_empty());
+        let centred = at(Penumbra::Centred);
+        assert!(centred.partial.is_empty(), "nothing above the top rims: {:?}", centred.partial);
+        assert_eq!(centred.partial_inner.len(), 2, "{:?}", centred.partial_inner);
+        let (edge, umbra, held) = (0.3 * 5.0 / 4.0, 0.25, 0.3 * 5.0 / 2.7 - 0.5 * 2.3 / 2.7);
+        for sheet in &centred.partial_inner {
+            let k = Vec2::from(sheet.normal).length();
+            assert!((k - (edge - held) / (edge - umbra)).abs() < 0.02 * k, "k {k}");
+            for s in [0.1, 0.5, 0.9] {
+                let x = |t: f32| sheet.point(s, t).x.abs();
+                assert!((x(0.0) - edge).abs() < 1e-3, "the bottom rim's hard edge at {}", x(0.0));
+                assert!((x(1.0 / k) - umbra).abs() < 0.01, "its umbra from {}", x(1.0 / k));
+                assert!((x(1.0) - held).abs() < 0.01, "held to {}", x(1.0));
+            }
+            assert_eq!(sheet.caster, 2.0);
+        }
     }
 
     /// A flat plate, cones of one radius: each corner's only wedge is its quarter turn, outside

@@ -155,6 +155,10 @@ pub struct PartialEdge {
     /// The third vertex of the face that has turned for that part, the way the silhouette from
     /// the light's centre lies.
     pub turned: u32,
+    /// The centre sees both faces lit: the edge lies on the hard shadow's outer side of the
+    /// silhouette, whose outer half it may widen. Else both unlit: it lies under the silhouette,
+    /// nearer the receiver, and may narrow its inner half.
+    pub lit: bool,
 }
 
 /// The edges that bound the light-facing part of the caster for part of a light sphere
@@ -228,7 +232,7 @@ pub fn partial_silhouettes(
             // points; where it sees both unlit, the one that has.
             let inner = if lit[f0] { thirds[1 - k] } else { thirds[k] };
             if turns {
-                out.push(PartialEdge { vertices: edge.vertices, inner, turned: thirds[k] });
+                out.push(PartialEdge { vertices: edge.vertices, inner, turned: thirds[k], lit: lit[f0] });
             }
         }
     }
@@ -374,15 +378,16 @@ mod tests {
         assert!(edges.iter().all(|(_, third)| *third != 4), "the fin seen from behind bounds nothing");
     }
 
-    /// Sorted partial silhouettes of a mesh in place, with their third vertices.
-    fn partial(positions: &[Vec3], triangles: &[[u32; 3]], light: Vec3, radius: f32) -> Vec<([u32; 2], u32)> {
+    /// Sorted partial silhouettes of a mesh in place, with their third vertices and whether the
+    /// centre sees their faces lit.
+    fn partial(positions: &[Vec3], triangles: &[[u32; 3]], light: Vec3, radius: f32) -> Vec<([u32; 2], u32, bool)> {
         let adjacency = EdgeAdjacency::build(triangles);
         let caster = Caster { positions, triangles, adjacency: &adjacency };
         let planes = FacePlanes::new(positions, triangles);
         let facing = planes.light_facing(&Mat4::IDENTITY, light);
         let edges = partial_silhouettes(&caster, &planes, &facing, &Mat4::IDENTITY, light, radius);
-        let mut edges: Vec<_> = edges.iter().map(|e| (e.vertices, e.inner)).collect();
-        edges.iter_mut().for_each(|(e, _)| e.sort_unstable());
+        let mut edges: Vec<_> = edges.iter().map(|e| (e.vertices, e.inner, e.lit)).collect();
+        edges.iter_mut().for_each(|(e, _, _)| e.sort_unstable());
         edges.sort_unstable();
         edges
     }
@@ -398,16 +403,19 @@ mod tests {
         // In front of the face, the light's part behind its plane sees it turned away: the
         // silhouette moves onto its edges with the lit +x and +y faces, which face that part.
         let front = found(0.4 + off, radius);
-        assert_eq!(front.iter().map(|(e, _)| *e).collect::<Vec<_>>(), [[5, 7], [6, 7]], "{front:?}");
+        assert_eq!(front.iter().map(|(e, _, _)| *e).collect::<Vec<_>>(), [[5, 7], [6, 7]], "{front:?}");
         assert!(
-            front.iter().all(|(_, third)| positions[*third as usize].z < 0.0),
+            front.iter().all(|(_, third, lit)| positions[*third as usize].z < 0.0 && *lit),
             "thirds on the lit faces: {front:?}"
         );
         // Behind it, the part in front sees it lit: its edges with the unlit −x and −y faces,
         // the face itself facing that part.
         let behind = found(0.4 - off, radius);
-        assert_eq!(behind.iter().map(|(e, _)| *e).collect::<Vec<_>>(), [[4, 5], [4, 6]], "{behind:?}");
-        assert!(behind.iter().all(|(_, third)| positions[*third as usize].z > 0.0), "thirds on the face: {behind:?}");
+        assert_eq!(behind.iter().map(|(e, _, _)| *e).collect::<Vec<_>>(), [[4, 5], [4, 6]], "{behind:?}");
+        assert!(
+            behind.iter().all(|(_, third, lit)| positions[*third as usize].z > 0.0 && !*lit),
+            "thirds on the face, the faces unlit: {behind:?}"
+        );
         // The face's own diagonal is no silhouette of any point; a light clear of every plane,
         // or a point, has none.
         assert!(found(0.4 + 8.0 * 5f32.to_radians().tan(), radius).is_empty());
@@ -463,7 +471,8 @@ mod tests {
                     let facing = if p0(*x) > 0.0 { v0 } else { v1 };
                     let mut key = e.vertices;
                     key.sort_unstable();
-                    prop_assert!(found.contains(&(key, facing)), "edge {:?} (third {facing}) missing from {found:?}", key);
+                    let lit = p0(centre) > 0.0;
+                    prop_assert!(found.contains(&(key, facing, lit)), "edge {:?} (third {facing}, lit {lit}) missing from {found:?}", key);
                 }
             }
         }

@@ -81,6 +81,8 @@ pub enum Blend {
     Add,
     /// min(dst, src): the darkest value wins.
     Min,
+    /// max(dst, src).
+    Max,
 }
 
 /// A graphics pipeline's description, declared with a named constructor and refined by
@@ -406,6 +408,7 @@ impl Pipeline {
         let op = match desc.blend {
             Blend::None | Blend::Add => vk::BlendOp::ADD,
             Blend::Min => vk::BlendOp::MIN,
+            Blend::Max => vk::BlendOp::MAX,
         };
         let attachment = vk::PipelineColorBlendAttachmentState::default()
             .color_write_mask(desc.color_write)
