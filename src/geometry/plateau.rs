@@ -1216,6 +1216,11 @@ mod tests {
 
     /// The sides of a caster in object space placed by `model`, from its face planes, as the
     /// technique builds them.
+    /// A light of `radius` at `position`, its penumbrae of the physical size, cones as wedges.
+    fn physical(position: Vec3, radius: f32, penumbra: Penumbra) -> PlateauLight {
+        PlateauLight { position, radius, size: PenumbraSize::Physical { scale: 1.0 }, penumbra, wedges: true }
+    }
+
     fn sides(light: &PlateauLight, caster: &Caster<'_>, model: &Mat4, number: f32) -> PlateauGeometry {
         let facing = FacePlanes::new(caster.positions, caster.triangles).light_facing(model, light.position);
         let edges = plateau_edges(caster, &facing, EdgeSource::Silhouettes);
@@ -1307,13 +1312,7 @@ mod tests {
             let model = Mat4::from_translation(Vec3::Y * 1.6) * Mat4::from_rotation_x(0.4);
             let caster = Caster { positions: mesh, triangles, adjacency: &adjacency };
             for position in [Vec3::new(0.5, 8.0, 0.3), Vec3::new(-6.0, 3.0, 2.0)] {
-                let light = PlateauLight {
-                    position,
-                    radius: 0.6,
-                    size: PenumbraSize::Physical { scale: 1.0 },
-                    penumbra: Penumbra::Centred,
-                    wedges: false,
-                };
+                let light = PlateauLight { wedges: false, ..physical(position, 0.6, Penumbra::Centred) };
                 let g = sides(&light, &caster, &model, 1.0);
                 let bounds = g.footprint.unwrap();
                 let cells = 200;
@@ -1387,13 +1386,7 @@ mod tests {
                 (Vec3::new(-6.0, 4.0, 2.0), Penumbra::Centred),
                 (Vec3::new(0.5, 8.0, 0.3), Penumbra::Outer),
             ] {
-                let light = PlateauLight {
-                    position,
-                    radius: 0.6,
-                    size: PenumbraSize::Physical { scale: 1.0 },
-                    penumbra,
-                    wedges: true,
-                };
+                let light = physical(position, 0.6, penumbra);
                 let wedged = sides(&light, &caster, &tilt, 1.0);
                 // Whole cones on request: a full turn at every penumbra vertex.
                 let whole = sides(&PlateauLight { wedges: false, ..light }, &caster, &tilt, 1.0);
@@ -1448,13 +1441,7 @@ mod tests {
         let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
         let adjacency = EdgeAdjacency::build(&triangles);
         let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
-        let light = PlateauLight {
-            position: Vec3::Y * 9.0,
-            radius: 0.5,
-            size: PenumbraSize::Physical { scale: 1.0 },
-            penumbra: Penumbra::Centred,
-            wedges: true,
-        };
+        let light = physical(Vec3::Y * 9.0, 0.5, Penumbra::Centred);
         for height in [0.3f32, 1.0, 4.0] {
             let g = sides(&light, &caster, &Mat4::from_translation(Vec3::Y * height), 1.0);
             let rim = height + 0.05;
@@ -1485,14 +1472,7 @@ mod tests {
         let planes = FacePlanes::new(&slab, &triangles);
         let model = Mat4::from_translation(Vec3::Y * 1.65);
         let at = |penumbra| {
-            let light = PlateauLight {
-                position: Vec3::Y * 5.0,
-                radius: 0.5,
-                size: PenumbraSize::Physical { scale: 1.0 },
-                penumbra,
-                wedges: true,
-            };
-            let ground = ReceiverPlane::ground(0.0);
+            let (ground, light) = (ReceiverPlane::ground(0.0), physical(Vec3::Y * 5.0, 0.5, penumbra));
             caster_sides(&ground, &light, (&caster, &planes), &model, EdgeSource::Silhouettes, 2.0)
         };
         let outer = at(Penumbra::Outer);
@@ -1525,13 +1505,8 @@ mod tests {
         let half = 9.0 / 7.95; // the top face (y = 1.05) casts the square |x|, |z| ≤ half
         // Haines' constant factor: circles, of one radius at one height.
         for penumbra in [Penumbra::Outer, Penumbra::Centred] {
-            let light = PlateauLight {
-                position: Vec3::Y * 9.0,
-                radius: 0.5,
-                size: PenumbraSize::Haines { factor: 0.1 },
-                penumbra,
-                wedges: true,
-            };
+            let light =
+                PlateauLight { size: PenumbraSize::Haines { factor: 0.1 }, ..physical(Vec3::Y * 9.0, 0.5, penumbra) };
             let g = sides(&light, &caster, &model, 1.0);
             // 90° and the overlap past each side: one piece per corner.
             assert_eq!(g.cones.len(), 4, "{penumbra:?}: {} wedges", g.cones.len());
@@ -1567,16 +1542,8 @@ mod tests {
         let (cube, triangles) = crate::geometry::shapes::cuboid(Vec3::new(2.0, 0.1, 2.0));
         let adjacency = EdgeAdjacency::build(&triangles);
         let caster = Caster { positions: &cube, triangles: &triangles, adjacency: &adjacency };
-        let at = |penumbra| {
-            let light = PlateauLight {
-                position: Vec3::Y * 9.0,
-                radius: 0.5,
-                size: PenumbraSize::Physical { scale: 1.0 },
-                penumbra,
-                wedges: true,
-            };
-            sides(&light, &caster, &Mat4::from_translation(Vec3::Y), 3.0)
-        };
+        let at =
+            |penumbra| sides(&physical(Vec3::Y * 9.0, 0.5, penumbra), &caster, &Mat4::from_translation(Vec3::Y), 3.0);
         let (outer, centred) = (at(Penumbra::Outer), at(Penumbra::Centred));
         // A sheet more per edge.
         assert_eq!(centred.sheets.len(), 2 * outer.sheets.len());
