@@ -191,11 +191,12 @@ bool centred_t(float t, float s, vec2 texel, out vec2 written) {
         // the silhouette's sheets, nearest edge and corners, say more: the hammer's thin handle
         // went 0.13 too dark across its shadow without the first, default's wingnut 0.13 beside
         // a corner without the others.
-        vec2 width = (in_shape0.zw + s * (in_shape1.xy - in_shape0.xy - in_shape0.zw)) / k / texel;
+        // ta − a and tb − b, the sheet's widths at its ends, in texels.
+        vec2 width = mix(in_shape0.zw, in_shape1.xy - in_shape0.xy, s) / k / texel;
         vec2 side = vec2(-width.y, width.x);
-        vec2 here = gl_FragCoord.xy;
-        if (caster_at(here) != in_caster || caster_at(here + width) != in_caster
-            || caster_at(here + width + side) != in_caster || caster_at(here + width - side) != in_caster) {
+        vec2 at = gl_FragCoord.xy;
+        if (caster_at(at) != in_caster || caster_at(at + width) != in_caster
+            || caster_at(at + width + side) != in_caster || caster_at(at + width - side) != in_caster) {
             return false;
         }
         float held = min(t * k, 1.0);

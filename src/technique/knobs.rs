@@ -52,17 +52,22 @@ impl Knob {
     pub fn show(&self, value: f64) -> String {
         let index = (value.fract() == 0.0 && value >= 0.0).then_some(value as usize);
         match index.and_then(|i| self.choices.get(i)) {
-            Some(choice) => choice.split('|').next().unwrap_or_default().to_string(),
+            Some(choice) => first_spelling(choice).to_string(),
             None => value.to_string(),
         }
     }
 
     /// `choices` for a listing: `0 outer, 1 centred`, a name's first spelling only.
     pub fn choice_list(&self) -> String {
-        let first = |c: &&str| c.split('|').next().unwrap_or_default().to_string();
-        let names: Vec<_> = self.choices.iter().map(first).enumerate().map(|(i, n)| format!("{i} {n}")).collect();
+        let names: Vec<_> =
+            self.choices.iter().map(|c| first_spelling(c)).enumerate().map(|(i, n)| format!("{i} {n}")).collect();
         names.join(", ")
     }
+}
+
+/// The name a choice is shown by: the first of its `|`-separated spellings.
+fn first_spelling(choice: &str) -> &str {
+    choice.split('|').next().unwrap_or_default()
 }
 
 /// Validated knob values of one technique; unset knobs take their defaults.

@@ -306,6 +306,12 @@ impl Side {
             Side::PartialInner => 2,
         }
     }
+
+    /// How its sides combine with what the texture holds: the darkest wins (§2), but the
+    /// partial silhouettes' inner halves, drawn last, only darken what the rest left.
+    fn blend(self) -> Blend {
+        if self == Side::PartialInner { Blend::Max } else { Blend::Min }
+    }
 }
 
 /// What a caster's cached sides were built from: rebuilt only when any of it changes.
@@ -662,7 +668,7 @@ impl Technique for Plateau {
                     let formats = [texture_format];
                     let desc = PipelineDesc::new("penumbra", vert, frag)
                         .colors(&formats)
-                        .blend(if side == Side::PartialInner { Blend::Max } else { Blend::Min })
+                        .blend(side.blend())
                         .constants(&constants);
                     Pipeline::new(ctx, &desc)
                 })?;
