@@ -114,6 +114,7 @@ fn shared_constants() -> Vec<(&'static str, String)> {
         FILTER_PCSS,
         SMOOTHIE_VERTEX_FLOATS,
         MIN_DEPTH,
+        MAX_INNER_REACH,
         KEEP_ALL,
         CUT_MARGIN,
         SLIVER,

@@ -82,8 +82,9 @@ fn scale(c: &mut Criterion) {
                 let partial = partial_silhouettes(&object, &mesh.planes, &facing, &model, light, 0.3);
                 let view = frustum.view * model;
                 let (near, far) = depth_range(&view, &mesh.bounds);
-                let mut geometry = smoothies(&view, &object, &edges, size, smoothie::Penumbra::Centred { near, far });
-                geometry.extend(&partial_smoothies(&view, &object, &partial, size));
+                let penumbra = smoothie::Penumbra::Centred { near, far };
+                let mut geometry = smoothies(&view, &object, &edges, size, penumbra);
+                geometry.extend(&partial_smoothies(&view, &object, &partial, size, penumbra));
                 geometry
             })
         });

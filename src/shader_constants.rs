@@ -39,6 +39,12 @@ pub const SMOOTHIE_VERTEX_FLOATS: usize = 26;
 /// Nearest light depth, relative to the caster's own, a vertex may have and still be drawn.
 pub const MIN_DEPTH: f32 = 1e-6;
 
+/// How many times its own penumbra's width (on the farthest receiver) an inward partial
+/// silhouette's sheet (`geometry::plateau::partial_sides`) or inner quad
+/// (`geometry::smoothie::partial_smoothies`) may reach: an edge at contact has none, and its
+/// umbra begins on its hard edge.
+pub const MAX_INNER_REACH: f32 = 64.0;
+
 /// What a smoothie that is no piece of a cut quad keeps (`SmoothieVertex::keep`): everything.
 pub const KEEP_ALL: [f32; 2] = [f32::MIN, f32::MAX];
 

@@ -10,7 +10,7 @@ mod common;
 use common::{
     HIDDEN_IN_THE_SPHERE, as_accurate_as, crossing, engine, error_minimising_scale, finish, l_shaped_slab,
     largest_difference, penumbra_pixels, plate_corner, reference, render_with, sees_at_the_corner, sphere_with,
-    suite_scene, terminator_error,
+    suite_scene, terminator_error, thick_slab_s_inner_half,
 };
 use softshadow::Capture;
 use softshadow::measure::{GROSS_ERROR, Metrics};
@@ -50,6 +50,16 @@ fn the_hard_shadow_s_corners_see_what_both_edges_leave_of_the_light() {
     for sets in [&[][..], &[("gpu_silhouettes", "1")]] {
         sees_at_the_corner(&plate_corner(), "smoothie", sets, (0.03, 0.06));
         sees_at_the_corner(&l_shaped_slab(), "smoothie", sets, (0.03, 0.06));
+    }
+}
+
+/// A thick slab (common::thick_slab_s_inner_half): the inner half is its bottom rim's, a partial
+/// silhouette's inner quad (geometry::smoothie::partial_smoothies), not its top rim's, the
+/// silhouette's (35 px against the reference's 27 without them); on both silhouette paths.
+#[test]
+fn a_thick_slab_s_inner_half_is_its_bottom_rim_s() {
+    for sets in [&[][..], &[("gpu_silhouettes", "1")]] {
+        thick_slab_s_inner_half("smoothie", sets);
     }
 }
 

@@ -47,6 +47,13 @@ void main() {
     if (!centred_fragment(c)) {
         discard;
     }
+    if (PARTIAL) {
+        // Blended by max (smoothie.rs): the zeros leave the other channels as they are.
+        out_outer = vec2(0.0);
+        out_inner = vec2(0.0, with_channel(c.alpha, in_channel));
+        out_odd = vec2(0.0);
+        return;
+    }
     if (c.inner) {
         out_outer = vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0);
         out_inner = vec2(1.0 - c.code, with_channel(c.alpha, in_channel));

@@ -17,6 +17,8 @@ layout(constant_id = 1) const bool CORNERS = false;
 layout(constant_id = 2) const bool CHAMFER = false;
 // The map's texels are the buffer's (equal sizes over one frustum), as the resolve's SAME_GRID.
 layout(constant_id = 3) const bool SAME_GRID = true;
+// The inner quads of partial silhouettes below the silhouette (partial_inner), blended by max.
+layout(constant_id = 4) const bool PARTIAL = false;
 
 // How the centred buffer stores an alpha: ½ + ½α. Near a corner V goes past what either edge
 // alone gives, an outer α' or an inner α below 0 (corner_alpha); 1 is still the clear's, lit
@@ -121,6 +123,35 @@ struct Centred {
     float limit;
 };
 
+// A partial silhouette's inner quad (geometry::smoothie::partial_smoothies): its edge lies
+// under the silhouette, whose depth b0 (in_corner.x) the buffer's inner depth holds, so its
+// alpha goes in converted, α·(1 − b0/r)/(1 − b/r), which the resolve's remap by 1 − b0/r takes
+// back to its own inner parameter on a receiver at r. r: the ground, the farthest receiver
+// behind (the map here holds the caster). On a nearer one the converted alpha errs light
+// ((b − b0)(1/r_ground − 1/r) ≤ 0), where max blending keeps the silhouette's. Kept only where
+// the map holds its caster here and a whole penumbra width further in, straight and ±45°, as
+// the plateau's partial sheets are (glsl/plateau/penumbra.frag): past a caster narrower than
+// its penumbra, or one turning a corner within it, the edge's half plane hides more than the
+// caster does.
+bool partial_inner(inout Centred c, float slack) {
+    float r = ground_depth(light, gl_FragCoord.xy / light.kernel.x);
+    float part = 1.0 - blocker_depth() / r;
+    if (!(part > 0.0)) {
+        return false;
+    }
+    vec2 p = fragment_tangent(), inward = in_normals.xy * (in_size * part);
+    vec2 deeper = p + inward, side = vec2(-inward.y, inward.x);
+    vec2 probes[4] = vec2[4](p, deeper, deeper + side, deeper - side);
+    for (int k = 0; k < 4; k++) {
+        float d = map_at(tangent_uv(light, probes[k]));
+        if (d < in_range.x - slack || d > in_range.y + slack) {
+            return false;
+        }
+    }
+    c.alpha = min(c.alpha / part, 1.0) * (1.0 - in_corner.x / r);
+    return true;
+}
+
 // False where the fragment says nothing (the clear's 1 stands).
 bool centred_fragment(out Centred c) {
     // A piece of a cut quad keeps its own part of the edge (geometry::smoothie's edge_quad).
@@ -135,6 +166,9 @@ bool centred_fragment(out Centred c) {
     c = Centred(INNER, alpha, depth_code(light, b), 1.0);
     // Two map texels' depth at b, what a face at 45° to the light spans across them.
     float slack = 2.0 * b * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / light.bias.w;
+    if (PARTIAL) {
+        return partial_inner(c, slack);
+    }
     if (c.inner) {
         // An inner texel counts only where the map's blocker is this caster (its depth within the
         // caster's range, within two texels' depth; not another caster in front or behind), and

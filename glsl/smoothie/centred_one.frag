@@ -17,6 +17,12 @@ void main() {
     if (!centred_fragment(c)) {
         discard;
     }
+    if (PARTIAL) {
+        // Blended by max (smoothie.rs): the zeros leave the other channels as they are.
+        out_outer = vec2(0.0);
+        out_inner = vec2(0.0, alpha_code(c.alpha));
+        return;
+    }
     out_outer = c.inner ? vec2(c.alpha < 1.0 ? INNER_MARK : 1.0, 1.0) : vec2(c.code, alpha_code(c.alpha));
     out_inner = c.inner ? vec2(1.0 - c.code, alpha_code(c.alpha)) : vec2(1.0);
 }

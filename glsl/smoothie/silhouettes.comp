@@ -17,12 +17,13 @@ layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
 layout(std430, set = 0, binding = 4) buffer Stamps { uint stamps[]; };
-// Four indirect draws, one per part of the smoothie pass (smoothie.rs's `Part::INDIRECT`): the outer
-// smoothies away from the hard shadow's corners and near them, then the inner quads alike. Each
-// kind takes a half of the vertex buffer, those away from corners appended from its start, those
-// near them from its end back, so that the smoothie pass draws each part with its own shader.
+// Five indirect draws, one per part of the smoothie pass (smoothie.rs's `Part::INDIRECT`): the outer
+// smoothies away from the hard shadow's corners and near them, the inner quads alike, then the
+// partial silhouettes' inner quads. Each kind takes a third of the vertex buffer, those away from
+// corners appended from its start, those near them from its end back, so that the smoothie pass
+// draws each part with its own shader.
 struct Draw { uint vertex_count; uint instance_count; uint first_vertex; uint first_instance; };
-layout(std430, set = 0, binding = 5) buffer Args { Draw draws[4]; };
+layout(std430, set = 0, binding = 5) buffer Args { Draw draws[5]; };
 // x, y, b, sx, sy, fx, fy, nx, ny, near, far, w, channel, cx, cy, normals, turn, along, keep, chamfer
 // (src/geometry/smoothie.rs's SmoothieVertex, SMOOTHIE_VERTEX_FLOATS of them)
 layout(std430, set = 0, binding = 6) writeonly buffer Vertices { float vertices[]; };
@@ -80,13 +81,15 @@ struct Vertex {
 };
 
 // Inner quads' extra data: the edge's outward normal (or a wedge's bisector) and the caster's
-// depth range; zero for the outer smoothies.
+// depth range; zero for the outer smoothies. `partial`: a partial silhouette's inner quad, which
+// has neither normal nor corner (its own data goes where a corner's would: partial_silhouette).
 struct Inner {
     vec2 normal;
     vec2 range;
+    bool partial;
 };
 
-const Inner OUTER = Inner(vec2(0.0), vec2(0.0));
+const Inner OUTER = Inner(vec2(0.0), vec2(0.0), false);
 
 // The hard shadow's corner a smoothie carries (src/geometry/smoothie.rs's ShadowCorner): its
 // vertex, both edges' outward normals, and its turn, 1 convex, -1 reflex; 0: none; and where a
@@ -112,10 +115,10 @@ void put(uint at, Vertex v, Inner inner, Corner c, vec2 keep) {
 }
 
 // Where `count` vertices of this kind go (an inner quad's range is its caster's depths, beyond
-// 0; the outer smoothies' is 0 or −1), near a corner or not; false where the kind's half of the
-// buffer is full (sized so that it never is).
+// 0; the outer smoothies' is 0 or −1; a partial silhouette's inner quad has no corner), near a
+// corner or not; false where the kind's third of the buffer is full (sized so that it never is).
 bool append(Inner inner, Corner c, uint count, out uint at) {
-    uint kind = inner.range.y > 0.0 ? 1u : 0u;
+    uint kind = inner.partial ? 2u : (inner.range.y > 0.0 ? 1u : 0u);
     if (c.turn == 0.0) {
         at = atomicAdd(draws[2u * kind].vertex_count, count);
         if (at + count > params.counts.z) {
@@ -548,7 +551,7 @@ void corner(Silhouette s, int k, uint count, uint other, Corner c) {
         if (bend < 0.0) {
             wedge(p, z, t, n1, n2, m, kk, OUTER, c);
         } else if (bend > 0.0 && params.counts.w != 0u) {
-            wedge(p, z, t, -n1, -n2, -m, kk, Inner(m, params.size.yw), c);
+            wedge(p, z, t, -n1, -n2, -m, kk, Inner(m, params.size.yw, false), c);
         }
         return;
     }
@@ -580,8 +583,10 @@ uint third_of(uvec4 t, uvec2 e) {
 
 // Centred, edge i's smoothie edges as a partial silhouette: a convex edge whose faces face the
 // light's centre alike while some point of the light sphere sees one of them turned (src/
-// geometry/silhouette.rs's partial_silhouettes), drawn where it reaches past what the turned
-// face's far vertex casts (src/geometry/smoothie.rs's partial_smoothies).
+// geometry/silhouette.rs's partial_silhouettes), drawn where it gains on what the turned face's
+// far vertex casts: an outer smoothie reaching further out where the centre sees both faces
+// lit, an inner quad whose umbra begins further out where it sees both unlit (src/geometry/
+// smoothie.rs's partial_smoothies).
 void partial_silhouette(uint i) {
     uvec4 e = edges[i];
     float radius = params.light.z;
@@ -633,19 +638,40 @@ void partial_silhouette(uint i) {
         if (pi.z <= MIN_DEPTH || pc.z <= MIN_DEPTH) {
             continue;
         }
+        // Away from that face: outward from an edge the centre sees lit, inward from one it
+        // sees unlit.
         vec2 perp = vec2(-along.y, along.x);
         vec2 normal = dot(perp, pi.xy / pi.z - ta) > 0.0 ? -perp : perp;
-        float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z);
-        float beyond = dot(normal, pc.xy / pc.z) + smoothie_t(pc.z);
-        float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - beyond;
+        float sa = smoothie_t(pa.z), sb = smoothie_t(pb.z), sc = smoothie_t(pc.z);
         float far = far_quad(ta, tb, sa, sb, normal);
-        if (gain <= params.light.w * max(sa * reach(pa.z, far), sb * reach(pb.z, far))) {
-            continue;
-        }
-        float behind = max(max(pa.z, pb.z), pc.z);
+        float ka = reach(pa.z, far), kb = reach(pb.z, far);
+        float needed = params.light.w * max(sa * ka, sb * kb);
+        vec2 tc = pc.xy / pc.z;
         Vertex q[4];
         edge_quad(ta, tb, pa.z, pb.z, normal, false, q);
-        quad(q, Inner(vec2(0.0), vec2(behind, -1.0)), NO_CORNER, KEEP_ALL);
+        if (p[0] > 0.0) {
+            // How far out its smoothie reaches, against the turned vertex's.
+            float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - (dot(normal, tc) + sc);
+            if (gain > needed) {
+                float behind = max(max(pa.z, pb.z), pc.z);
+                quad(q, Inner(vec2(0.0), vec2(behind, -1.0), false), NO_CORNER, KEEP_ALL);
+            }
+            continue;
+        }
+        // Where the umbra begins along the inward normal, against the turned vertex's (the
+        // silhouette's umbra); the quad carries the silhouette's depth there, and the inward
+        // normal, where a corner's vertex and normals go.
+        float hold = dot(normal, tc) + sc * reach(pc.z, far);
+        if (hold - max(dot(normal, ta) + sa * ka, dot(normal, tb) + sb * kb) > needed) {
+            // Past its own umbra's start it still hides the whole light, as far as the
+            // silhouette's inner half reaches: the quad reaches there, its alpha past 1.
+            float da = clamp(hold - dot(normal, ta), sa * ka, MAX_INNER_REACH * sa * ka);
+            float db = clamp(hold - dot(normal, tb), sb * kb, MAX_INNER_REACH * sb * kb);
+            q[2] = Vertex(tb + normal * db, pb.z, vec2(sb > 0.0 ? db / sb : 0.0, 0.0), vec2(0.0), weight(sb), 1.0);
+            q[3] = Vertex(ta + normal * da, pa.z, vec2(sa > 0.0 ? da / sa : 0.0, 0.0), vec2(0.0), weight(sa), 0.0);
+            quad(q, Inner(vec2(0.0), params.size.yw, true), Corner(vec2(pc.z, 0.0), vec4(normal, 0.0, 0.0), 0.0, vec3(0.0)),
+                 KEEP_ALL);
+        }
     }
 }
 
@@ -704,5 +730,5 @@ void main() {
     edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], -s.normal, true, inner);
     vec2 cuts = corner_cuts(outer, inner, corners);
     edge_pieces(outer, OUTER, corners, cuts);
-    edge_pieces(inner, Inner(s.normal, params.size.yw), corners, cuts);
+    edge_pieces(inner, Inner(s.normal, params.size.yw, false), corners, cuts);
 }

@@ -23,7 +23,7 @@ use std::f32::consts::TAU;
 
 use rayon::prelude::*;
 
-use crate::shader_constants::{FOLD_SLACK, SHEET_SLACK, SHEET_VEC4S, WEDGE_VEC4S};
+use crate::shader_constants::{FOLD_SLACK, MAX_INNER_REACH, SHEET_SLACK, SHEET_VEC4S, WEDGE_VEC4S};
 
 use super::silhouette::{
     Caster, EdgeSource, FacePlanes, Facing, PARTIAL_GAIN, PartialEdge, partial_silhouettes, penumbra_edges,
@@ -949,10 +949,6 @@ pub fn partial_sides(
     }
     out
 }
-
-/// How many times its own width an inward partial silhouette's sheet may reach ([`partial_sides`]):
-/// an edge at contact has none, and its umbra begins on its hard edge.
-const MAX_INNER_REACH: f32 = 64.0;
 
 /// The parts of a vertex's cone that none of the sheets there cover (`covered`: sectors from
 /// the apex, see [`Covers`]), into `out`; `scratch`: reused arc lists.

@@ -42,7 +42,9 @@ use super::chains::{self, MergedEdge, PenumbraEdge};
 use super::plateau::MIN_TURN;
 use super::silhouette::{Caster, EdgeSource, FacePlanes, PARTIAL_GAIN, PartialEdge, penumbra_edges};
 pub use crate::shader_constants::KEEP_ALL;
-use crate::shader_constants::{CUT_MARGIN, KEEP_SLACK, MAX_WALK, MIN_DEPTH, RUN_STRAY, SLIVER, SMOOTHIE_VERTEX_FLOATS};
+use crate::shader_constants::{
+    CUT_MARGIN, KEEP_SLACK, MAX_INNER_REACH, MAX_WALK, MIN_DEPTH, RUN_STRAY, SLIVER, SMOOTHIE_VERTEX_FLOATS,
+};
 
 /// One smoothie vertex.
 #[repr(C)]
@@ -78,10 +80,12 @@ pub struct SmoothieVertex {
     /// the parity of its number; see [`SmoothieGeometry::in_channel`]).
     pub channel: f32,
     /// Centred, near a corner of the hard shadow ([`ShadowCorner`]): its vertex, tangent
-    /// coordinates; zero elsewhere.
+    /// coordinates; zero elsewhere. A partial silhouette's inner quad, which has no corner
+    /// ([`partial_smoothies`]): the silhouette's depth there in `cx`.
     pub cx: f32,
     pub cy: f32,
-    /// Its two edges' outward normals.
+    /// Its two edges' outward normals; a partial silhouette's inner quad: its inward normal,
+    /// then zeros.
     pub normals: [f32; 4],
     /// 1 where the hard shadow is convex there, −1 reflex; 0: no corner.
     pub turn: f32,
@@ -233,6 +237,9 @@ pub struct SmoothieGeometry {
     pub corners: Vec<SmoothieVertex>,
     /// The edges' inner quads ([`Penumbra::Centred`]).
     pub inner: Vec<SmoothieVertex>,
+    /// The inner quads of partial silhouettes below the silhouette ([`partial_smoothies`]),
+    /// drawn last, blended by max.
+    pub partial_inner: Vec<SmoothieVertex>,
 }
 
 impl SmoothieGeometry {
@@ -240,10 +247,11 @@ impl SmoothieGeometry {
         self.edges.extend_from_slice(&other.edges);
         self.corners.extend_from_slice(&other.corners);
         self.inner.extend_from_slice(&other.inner);
+        self.partial_inner.extend_from_slice(&other.partial_inner);
     }
 
     pub fn is_empty(&self) -> bool {
-        self.edges.is_empty() && self.corners.is_empty() && self.inner.is_empty()
+        self.vertices().next().is_none()
     }
 
     /// The same smoothies in the centred smoothie buffer's channel for caster number `number`,
@@ -251,7 +259,8 @@ impl SmoothieGeometry {
     /// winning, unless their numbers have the same parity (`glsl/smoothie/centred.frag`).
     pub fn in_channel(mut self, number: u32) -> Self {
         let c = (number % 2) as f32;
-        for v in self.edges.iter_mut().chain(&mut self.corners).chain(&mut self.inner) {
+        let all = self.edges.iter_mut().chain(&mut self.corners).chain(&mut self.inner);
+        for v in all.chain(&mut self.partial_inner) {
             v.channel = c;
         }
         self
@@ -267,24 +276,25 @@ impl SmoothieGeometry {
         }))
     }
 
-    /// Every vertex: the outer smoothies', then the inner quads'.
+    /// Every vertex: the outer smoothies', then the inner quads', the partial silhouettes' last.
     pub fn vertices(&self) -> impl Iterator<Item = &SmoothieVertex> {
-        self.edges.iter().chain(&self.corners).chain(&self.inner)
+        self.edges.iter().chain(&self.corners).chain(&self.inner).chain(&self.partial_inner)
     }
 
     /// Every triangle in the smoothie pass's drawing order, and how many vertices each of its
     /// draws takes: the outer smoothies away from the hard shadow's corners, those near one
     /// ([`SmoothieVertex::turn`]), those near a chamfered one ([`SmoothieVertex::chamfer`]),
-    /// then the inner quads alike. Each kind is drawn apart, with its own arithmetic, which
-    /// llvmpipe would run on every fragment of a draw that held any.
-    pub fn drawn(&self) -> (Vec<SmoothieVertex>, [u32; 6]) {
+    /// then the inner quads alike, then the partial silhouettes' inner quads. Each kind is drawn
+    /// apart, with its own arithmetic, which llvmpipe would run on every fragment of a draw that
+    /// held any.
+    pub fn drawn(&self) -> (Vec<SmoothieVertex>, [u32; 7]) {
         let kind = |v: &SmoothieVertex| match (v.turn != 0.0, v.chamfer != [0.0; 3]) {
             (false, _) => 0,
             (true, false) => 1,
             (true, true) => 2,
         };
         let mut out = Vec::with_capacity(self.vertices().count());
-        let mut counts = [0; 6];
+        let mut counts = [0; 7];
         let outer = self.edges.chunks(3).chain(self.corners.chunks(3));
         for (part, triangles) in [outer.collect::<Vec<_>>(), self.inner.chunks(3).collect()].iter().enumerate() {
             for (k, count) in counts[3 * part..3 * part + 3].iter_mut().enumerate() {
@@ -293,6 +303,8 @@ impl SmoothieGeometry {
                 *count = (out.len() - before) as u32;
             }
         }
+        out.extend_from_slice(&self.partial_inner);
+        counts[6] = self.partial_inner.len() as u32;
         (out, counts)
     }
 }
@@ -630,30 +642,44 @@ fn near_corner(v: SmoothieVertex, c: Option<ShadowCorner>) -> SmoothieVertex {
 
 /// Centred, the smoothie edges of a caster's partial silhouettes (`edges`, from
 /// [`partial_silhouettes`](super::silhouette::partial_silhouettes)) seen through `view`, as
-/// [`smoothies`] makes a silhouette's, where one reaches [`PARTIAL_GAIN`] of its size past the
-/// smoothie its turned face's far vertex would have. Such an edge lies over its caster's own
-/// outline in the map, where a face seen nearly edge-on from the light's centre is a sliver
-/// beside the silhouette, and for the part of the light behind that face it is the silhouette:
-/// its smoothie, nearer the light than the silhouette's, reaches further out. Marked (near,
-/// far) = (b, −1): the smoothie pass keeps them only where the map's surface lies behind b
-/// (by 2 % or two map texels, whichever is more: glsl/smoothie/centred.glsl), so they only
-/// darken the outer half, and only receivers behind b, the deepest of the edge's and the
-/// turned vertex's depths: the turned face's own surface, which its soft terminator already
-/// shades (the resolve), lies in front (low_light's front face: 759 px too dark by over 0.1
-/// without it). No corners: the silhouette's cover the outline's turns. The reach compared is
-/// the alpha's on the farthest receiver (t·k, [`reach`]); on any receiver at depth r the
-/// difference of two smoothies' reach is that of their t, R/b − R/r taken from both.
+/// [`smoothies`] makes a silhouette's. Such an edge lies over its caster's own outline in the
+/// map, where a face seen nearly edge-on from the light's centre is a sliver beside the
+/// silhouette, and for the part of the light on the far side of that face (the turned face) it
+/// is the silhouette. Each is drawn only where it gains [`PARTIAL_GAIN`] of its reach on the
+/// silhouette, about the turned face's far vertex (reaches compared on the farthest receiver,
+/// t·k: [`reach`]; on any receiver at depth r two smoothies' reaches differ by their t, R/b −
+/// R/r taken from both). No corners: the silhouette's cover the outline's turns. Outer only,
+/// nothing: the paper's penumbra spans the whole width outward, its umbra the whole hard shadow.
+///
+/// - An edge whose faces the centre sees lit lies above the silhouette, nearer the light, and
+///   its smoothie reaches further out. Its outer smoothie goes to `edges`, marked (near, far) =
+///   (b, −1): the smoothie pass keeps them only where the map's surface lies behind b (by 2 % or
+///   two map texels, whichever is more: glsl/smoothie/centred.glsl), so they only darken the
+///   outer half, and only receivers behind b, the deepest of the edge's and the turned vertex's
+///   depths: the turned face's own surface, which its soft terminator already shades (the
+///   resolve), lies in front (low_light's front face: 759 px too dark by over 0.1 without it).
+/// - An edge whose faces the centre sees unlit lies below it, nearer the receiver, and for the
+///   part of the light in front of its turned face, which a receiver inside the hard shadow
+///   still sees, it is the silhouette, with the narrower penumbra (a thick slab: the truth's
+///   umbra begins where its bottom rim's does, not its top rim's). Its inner quad goes to
+///   `partial_inner`, with the caster's depth range as an inner quad's, its inward normal and
+///   the turned vertex's depth, the silhouette's there (see [`SmoothieVertex::cx`]). The
+///   smoothie pass draws them last and blends their alphas by max, converted to the
+///   silhouette's depth, so they only darken: each edge's half plane lets through at least what
+///   the caster does, so the darkest of them is the nearest to the truth.
 pub fn partial_smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
     edges: &[PartialEdge],
     (size, receivers): (SmoothieSize, ReceiverBound),
+    penumbra: Penumbra,
 ) -> SmoothieGeometry {
+    let mut out = SmoothieGeometry::default();
+    let Penumbra::Centred { near, far: deepest } = penumbra else { return out };
     let project = |i: u32| {
         let p = view.transform_point3(caster.positions[i as usize]);
         (p.z > MIN_DEPTH).then(|| (Vec2::new(p.x, p.y) / p.z, p.z))
     };
-    let mut out = SmoothieGeometry::default();
     for edge in edges {
         let [a, b] = edge.vertices;
         let (Some((pa, za)), Some((pb, zb))) = (project(a), project(b)) else { continue };
@@ -662,21 +688,44 @@ pub fn partial_smoothies(
         else {
             continue;
         };
-        // Outward: away from the face that faces the light's part they bound.
+        // Away from the face that faces the light's part they bound: outward from an edge above
+        // the silhouette, inward from one below it.
         let normal = if along.perp().dot(inside - pa) > 0.0 { -along.perp() } else { along.perp() };
         let far = receivers.far_over([(pa, za), (pb, zb)].into_iter().flat_map(|(p, z)| [p, p + normal * size.at(z)]));
         let ends = [(pa, za), (pb, zb)].map(|(p, z)| (p, z, reach(z, far), size.at(z)));
-        let extent = |p: Vec2, z: f32| normal.dot(p) + size.at(z);
         let half = ends.iter().map(|(_, _, k, t)| t * k).fold(0.0, f32::max);
-        if extent(pa, za).max(extent(pb, zb)) - extent(pc, zc) <= PARTIAL_GAIN * half {
+        if edge.lit {
+            // How far out its smoothie reaches, against the turned vertex's.
+            let extent = |p: Vec2, z: f32| normal.dot(p) + size.at(z);
+            if extent(pa, za).max(extent(pb, zb)) - extent(pc, zc) <= PARTIAL_GAIN * half {
+                continue;
+            }
+            let behind = za.max(zb).max(zc);
+            let [a, b] = ends.map(|(p, z, k, t)| {
+                [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)]
+                    .map(|v| weighted(SmoothieVertex { near: behind, far: -1.0, ..v }, t))
+            });
+            quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
             continue;
         }
-        let behind = za.max(zb).max(zc);
+        // Where the umbra begins along the inward normal, on the farthest receiver, against the
+        // turned vertex's.
+        let umbra = |p: Vec2, z: f32| normal.dot(p) + size.at(z) * reach(z, far);
+        if umbra(pc, zc) - umbra(pa, za).max(umbra(pb, zb)) <= PARTIAL_GAIN * half {
+            continue;
+        }
+        // Past its own umbra's start the edge still hides the whole light, as far as the
+        // silhouette's inner half reaches: the quad reaches there, its alpha past 1 (umbra).
+        let hold = umbra(pc, zc);
+        let normals = [normal.x, normal.y, 0.0, 0.0];
         let [a, b] = ends.map(|(p, z, k, t)| {
-            [vertex(p, z, Vec2::ZERO), vertex(p + normal * t * k, z, Vec2::X * k)]
-                .map(|v| weighted(SmoothieVertex { near: behind, far: -1.0, ..v }, t))
+            let reach = (hold - normal.dot(p)).clamp(t * k, MAX_INNER_REACH * t * k);
+            let alpha = if t > 0.0 { reach / t } else { 0.0 };
+            [(p, 0.0), (p + normal * reach, alpha)].map(|(q, alpha)| {
+                weighted(SmoothieVertex { near, far: deepest, cx: zc, normals, ..vertex(q, z, Vec2::X * alpha) }, t)
+            })
         });
-        quad(&mut out.edges, [a[0], b[0], b[1], a[1]]);
+        quad(&mut out.partial_inner, [a[0], b[0], b[1], a[1]]);
     }
     out
 }
@@ -941,6 +990,7 @@ fn wedge(out: &mut Vec<SmoothieVertex>, n: [Vec2; 2], m: Vec2, k: f32, at: impl 
 mod tests {
     use super::*;
     use crate::geometry::EdgeAdjacency;
+    use crate::geometry::silhouette::partial_silhouettes;
     use proptest::prelude::*;
 
     /// A unit plate at `height`: positions, triangles and their adjacency.
@@ -1477,6 +1527,49 @@ mod tests {
         }
     }
 
+    /// A thick slab (0.6 × 1.3 m, 4 m long, from 1 m up) under a light of radius 0.5 m 5 m
+    /// straight above it, the ground 5 m below the light: its sides' bottom rims (tangent x =
+    /// ±0.3/4), unlit from the centre and lit from the light's rim, are its partial silhouettes
+    /// under the top rims (±0.3/2.7). Centred, each gets an inner quad from its edge inward,
+    /// alpha 0 there, its own umbra (α = 1 − 4/5 of t = 0.5/4) at ±0.05 (x = 0.25 m on the
+    /// ground), held on to where the top rim's inner half ends, ±(0.3 − 0.5·(1 − 2.7/5))/2.7,
+    /// carrying the top rim's depth 2.7 and the inward normal. Outer only, nothing.
+    #[test]
+    fn a_thick_slab_s_bottom_rims_narrow_its_inner_halves() {
+        let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(0.6, 1.3, 4.0));
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
+        let planes = FacePlanes::new(&slab, &triangles);
+        let (model, light) = (Mat4::from_translation(Vec3::Y * 1.65), Vec3::Y * 5.0);
+        let partial = partial_silhouettes(&caster, &planes, &planes.light_facing(&model, light), &model, light, 0.5);
+        // Looking down from the light: view (x, y, z) = world (x, z, 5 − y).
+        let view =
+            Mat4::from_cols(glam::Vec4::X, -glam::Vec4::Z, glam::Vec4::Y, glam::Vec4::new(0.0, 0.0, 5.0, 1.0)) * model;
+        let size = (SmoothieSize::Physical { light_radius: 0.5, scale: 1.0, behind: 0.0 }, ReceiverBound::up_to(5.0));
+        let outer = partial_smoothies(&view, &caster, &partial, size, Penumbra::Outer);
+        assert!(outer.is_empty(), "outer only: {outer:?}");
+        let (near, far) = (2.7, 4.0);
+        let centred = partial_smoothies(&view, &caster, &partial, size, Penumbra::Centred { near, far });
+        assert!(centred.edges.is_empty(), "nothing above the top rims: {:?}", centred.edges);
+        assert_eq!(centred.partial_inner.len(), 2 * 6, "one quad per bottom rim");
+        let (edge, t, held) = (0.3 / 4.0, 0.5 / 4.0, (0.3 - 0.5 * (1.0 - 2.7 / 5.0)) / 2.7);
+        for v in &centred.partial_inner {
+            let x = v.x.abs();
+            let alpha = Vec2::new(v.sx, v.sy).length();
+            assert!((v.b - 4.0).abs() < 1e-4 && (v.cx - 2.7).abs() < 1e-4, "depths {} and {}", v.b, v.cx);
+            assert!((v.near, v.far) == (near, far) && v.turn == 0.0, "{v:?}");
+            assert!(v.normals[0] * v.x < 0.0 && (v.normals[0].abs() - 1.0).abs() < 1e-5, "inward: {v:?}");
+            if alpha == 0.0 {
+                assert!((x - edge).abs() < 1e-5, "the bottom rim at {x}");
+            } else {
+                assert!((x - held).abs() < 1e-4, "held to {x}, not {held}");
+                assert!((alpha - (edge - held) / t).abs() < 1e-4, "alpha {alpha} there");
+            }
+        }
+        // Its own umbra at alpha 1 − b/r = 0.2, 0.025 in from the edge.
+        assert!((edge - 0.2 * t - 0.05).abs() < 1e-6);
+    }
+
     #[test]
     fn drawn_puts_the_smoothies_near_corners_apart() {
         let t = 0.01;
@@ -1486,16 +1579,21 @@ mod tests {
             &[Vec2::new(-4.0 * t, 0.0), Vec2::new(-0.3 * t, 0.0), Vec2::new(0.0, 0.3 * t), Vec2::new(0.0, 4.0 * t)],
             t,
         ));
+        // A partial silhouette's inner quad (partial_smoothies), marked apart by its depth.
+        let partial = SmoothieVertex { cx: 2.0, ..g.inner[0] };
+        g.partial_inner = vec![partial; 6];
         let (vertices, counts) = g.drawn();
         assert_eq!(counts.iter().sum::<u32>() as usize, g.vertices().count());
         assert!(counts.iter().all(|&c| c > 0 && c % 3 == 0), "every part: {counts:?}");
+        let (parts, last) = counts.split_at(6);
         let mut at = 0;
-        for (k, &count) in counts.iter().enumerate() {
+        for (k, &count) in parts.iter().enumerate() {
             let part = &vertices[at..at + count as usize];
             assert!(part.iter().all(|v| (v.turn != 0.0) == (k % 3 != 0)), "part {k}: corners");
             assert!(part.iter().all(|v| (v.chamfer != [0.0; 3]) == (k % 3 == 2)), "part {k}: chamfers");
             assert!(part.iter().all(|v| (v.near != 0.0) == (k >= 3)), "part {k}: outer, then inner");
             at += count as usize;
         }
+        assert_eq!(&vertices[at..], &g.partial_inner[..last[0] as usize], "the partial silhouettes' last");
     }
 }

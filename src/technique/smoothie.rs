@@ -45,12 +45,18 @@
 //! pixels on overlap and two_boxes from 90 and 51 to 0 (512², against the reference).
 //!
 //! Partial silhouettes, centred, as the plateau's: a face within the light's angular radius of
-//! edge-on hands the silhouette to its other edge for part of the light, whose smoothie reaches
-//! further out (`low_light`: 137 leaking pixels, 27 with them). Their smoothie edges
-//! (`geometry::smoothie::partial_smoothies`, and the compute path's) lie over their caster's
-//! outline in the map; the smoothie pass keeps them where the map's surface lies behind the
-//! turned face (lit, or another receiver, which a partial silhouette shadows as it does the
-//! ground), and the resolve lets them darken only receivers behind the turned face.
+//! edge-on hands the silhouette to its other edge for part of the light. Above the silhouette
+//! (both faces lit from the centre) that edge's smoothie reaches further out (`low_light`: 137
+//! leaking pixels, 27 with them). Their smoothie edges (`geometry::smoothie::partial_smoothies`,
+//! and the compute path's) lie over their caster's outline in the map; the smoothie pass keeps
+//! them where the map's surface lies behind the turned face (lit, or another receiver, which a
+//! partial silhouette shadows as it does the ground), and the resolve lets them darken only
+//! receivers behind the turned face. Below it (both unlit), nearer the receiver, the edge is
+//! the silhouette for the part of the light a receiver inside the hard shadow still sees, with
+//! the narrower inner half: its inner quad is drawn last, its alpha converted to the
+//! silhouette's depth and blended by max into the inner alpha (`Part::PARTIAL_INNER`). A thick
+//! slab's inner half (tests/smoothie_centred.rs): 28 px against the reference's 27, 35 before
+//! (128², RMSE over the image 0.023 → 0.0064).
 //!
 //! Corners, centred (`geometry::smoothie::ShadowCorner`): where two edges of the hard shadow's
 //! outline turn, the truth cuts the light's footprint by both lines, ¾ of the light at a right
@@ -552,7 +558,7 @@ impl Smoothie {
             } else {
                 smoothies(&view, &caster, &c.edges, (size, receivers), penumbra)
             };
-            geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, receivers)));
+            geometry.extend(&partial_smoothies(&view, &caster, &c.partial, (size, receivers), penumbra));
             if !frustum.window_of(&mesh.bounds.transformed(&model)).iter().all(|v| v.is_finite()) {
                 windows.push(EVERYWHERE);
             } else if let Some([x0, y0, x1, y1]) = geometry.window() {
@@ -701,15 +707,19 @@ impl Technique for Smoothie {
                     ("CORNERS", u32::from(part.corners)),
                     ("CHAMFER", u32::from(part.chamfer)),
                     ("SAME_GRID", u32::from(same_grid)),
+                    ("PARTIAL", u32::from(part.partial)),
                 ]
             } else {
                 Vec::new()
             };
+            // Every channel by minimum (the shader's), but the partial silhouettes' inner quads,
+            // which only darken what the others left.
+            let blend = if part.partial { Blend::Max } else { Blend::Min };
             let desc = PipelineDesc::new("smoothie_buffer", &shaders::SMOOTHIE_SMOOTHIE_VERT, layout.fragment_shader())
                 .vertex_input(VertexInput::Floats(&[3, 2, 2, 2, 2, 1, 1, 2, 4, 1, 1, 2, 3]))
                 .colors(formats)
                 .constants(&constants)
-                .blend(Blend::Min);
+                .blend(blend);
             Pipeline::new(ctx, &desc)
         };
         // Made before anything is recorded, so that a failure leaves no pass half recorded.
@@ -867,7 +877,7 @@ enum Smoothies {
     /// [`Part`] (in the order of [`Part::ALL`]).
     Direct {
         vertices: vk::DescriptorBufferInfo,
-        counts: [u32; 6],
+        counts: [u32; 7],
     },
     /// The compute path's: an indirect draw per part of [`Part::INDIRECT`], one after the other in `args`.
     Indirect {
@@ -910,7 +920,9 @@ enum Draw {
 
 /// Which smoothies a draw of the smoothie pass holds: the outer smoothies or the inner quads
 /// (`INNER`, glsl/smoothie/centred.glsl), near the hard shadow's corners or not (`CORNERS`),
-/// chamfered ones among them or not (`CHAMFER`).
+/// chamfered ones among them or not (`CHAMFER`), or the inner quads of partial silhouettes
+/// below the silhouette (`PARTIAL`), drawn last and blended by max
+/// (`geometry::smoothie::partial_smoothies`).
 /// Centred, each is drawn apart, running only its own part of the shader, since llvmpipe runs
 /// both branches of a test it cannot fold. Outer and inner drawn together, every fragment ran
 /// both; the images are the same bit for bit (the suite, both paths), and apart the smoothie
@@ -923,31 +935,40 @@ struct Part {
     inner: bool,
     corners: bool,
     chamfer: bool,
+    partial: bool,
 }
 
 impl Part {
+    const fn new(inner: bool, corners: bool, chamfer: bool) -> Self {
+        Part { inner, corners, chamfer, partial: false }
+    }
+
+    const PARTIAL_INNER: Part = Part { inner: true, corners: false, chamfer: false, partial: true };
+
     /// The CPU path's parts, in drawing order (`SmoothieGeometry::drawn`): the chamfered corners
     /// apart, whose three line pairs cost twice the corner's arithmetic again; drawn with the
     /// others, every corner fragment paid it. contact's smoothie pass (512², lavapipe, medians of
     /// six interleaved runs of 40 frames): 5.92 ms before the chamfers, 7.3 with every corner
     /// paying them, 6.65 with them apart (6.02 with their arithmetic off), 5.85–5.99 since
     /// corners.glsl's corner_v runs one disk_in_both and takes the angles from the vertices.
-    const ALL: [Part; 6] = [
-        Part { inner: false, corners: false, chamfer: false },
-        Part { inner: false, corners: true, chamfer: false },
-        Part { inner: false, corners: true, chamfer: true },
-        Part { inner: true, corners: false, chamfer: false },
-        Part { inner: true, corners: true, chamfer: false },
-        Part { inner: true, corners: true, chamfer: true },
+    const ALL: [Part; 7] = [
+        Part::new(false, false, false),
+        Part::new(false, true, false),
+        Part::new(false, true, true),
+        Part::new(true, false, false),
+        Part::new(true, true, false),
+        Part::new(true, true, true),
+        Part::PARTIAL_INNER,
     ];
 
     /// The compute path's, one indirect draw each (silhouettes.comp's `Args`): its corners,
     /// chamfered or not, in one draw, whose every fragment pays the chamfer's arithmetic.
-    const INDIRECT: [Part; 4] = [
-        Part { inner: false, corners: false, chamfer: false },
-        Part { inner: false, corners: true, chamfer: true },
-        Part { inner: true, corners: false, chamfer: false },
-        Part { inner: true, corners: true, chamfer: true },
+    const INDIRECT: [Part; 5] = [
+        Part::new(false, false, false),
+        Part::new(false, true, true),
+        Part::new(true, false, false),
+        Part::new(true, true, true),
+        Part::PARTIAL_INNER,
     ];
 }
 

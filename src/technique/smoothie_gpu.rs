@@ -2,8 +2,9 @@
 //! hardware could not feed a shader's output back into a vertex array (§6): one compute
 //! invocation per edge finds silhouettes and pairs the edge ends at each silhouette vertex, then
 //! one more appends smoothie edges and corners (`glsl/smoothie/silhouettes.comp`); the smoothie
-//! pass draws them with four indirect draws, the outer smoothies and the inner quads apart, each
-//! away from the hard shadow's corners and near them. Each
+//! pass draws them with five indirect draws, the outer smoothies and the inner quads apart, each
+//! away from the hard shadow's corners and near them, and the partial silhouettes' inner quads.
+//! Each
 //! mesh's positions, triangles, edges and per-vertex stamped slots are uploaded once, while it
 //! is drawn. The output (one copy, not one per frame in flight) is only recomputed when a
 //! caster, the light view or the smoothie size changed: a static scene records no silhouette
@@ -32,10 +33,10 @@ use crate::shader_constants::{COMPUTE_GROUP, STAGE_DRAW, STAGE_OWN, STAGE_PAIR, 
 const PARAMS_BYTES: u64 = std::mem::size_of::<SilhouetteParams>() as u64;
 /// Bytes per smoothie vertex ([`crate::geometry::smoothie::SmoothieVertex`]).
 const VERTEX_BYTES: u64 = std::mem::size_of::<crate::geometry::smoothie::SmoothieVertex>() as u64;
-/// Four `VkDrawIndirectCommand`s, one per part of the smoothie pass (`smoothie.rs`'s `Part::INDIRECT`):
-/// the outer smoothies', away from the hard shadow's corners and near them, then the inner
-/// quads' alike.
-const DRAWS_BYTES: u64 = 4 * DRAW_COMMAND_BYTES;
+/// Five `VkDrawIndirectCommand`s, one per part of the smoothie pass (`smoothie.rs`'s `Part::INDIRECT`):
+/// the outer smoothies', away from the hard shadow's corners and near them, the inner quads'
+/// alike, then the partial silhouettes' inner quads.
+const DRAWS_BYTES: u64 = 5 * DRAW_COMMAND_BYTES;
 
 /// One mesh's connectivity on the GPU.
 struct MeshBuffers {
@@ -128,7 +129,7 @@ impl GpuSilhouettes {
 
     /// Records the silhouette dispatches of every caster seen through `view`, each from the mesh
     /// `cast` gives its scene object (the shadow mesh the map is drawn from, as on the CPU path);
-    /// returns the vertex buffer and the arguments of the smoothie pass's four indirect draws
+    /// returns the vertex buffer and the arguments of the smoothie pass's five indirect draws
     /// ([`DRAWS_BYTES`]).
     pub fn record(
         &mut self,
@@ -150,14 +151,15 @@ impl GpuSilhouettes {
         // Per edge, outer only, a quad of six vertices; centred, up to three pieces of its quad
         // (`ShadowCorner::piece`), each with a sliver of three, or a partial silhouette's two quads,
         // and as many of its inner quad; at most three quads per corner. As many for each kind
-        // in its half of the buffer (the inner quads', centred).
+        // in its third of the buffer (centred: the inner quads', the partial silhouettes' inner
+        // quads').
         let per_edge = if centred { 3 * (6 + 3) } else { 6 };
         // That bound is every edge a silhouette with a corner at both ends; a silhouette is a
         // small part of a mesh's edges, and the output is bound as one storage buffer, which may
         // hold no more than maxStorageBufferRange (128 MiB on lavapipe, which the bound of a full
         // 20 000-triangle knot passes): no more than that, the shader drops what would not fit.
-        let halves = 1 + u64::from(centred);
-        let most = u64::from(ctx.info.max_storage_buffer_range) / (halves * VERTEX_BYTES);
+        let kinds = 1 + 2 * u64::from(centred);
+        let most = u64::from(ctx.info.max_storage_buffer_range) / (kinds * VERTEX_BYTES);
         let capacity: u64 = casters
             .iter()
             .map(|o| (per_edge * o.mesh.adjacency.edges.len() + 6 * 3 * o.mesh.positions.len()) as u64)
@@ -168,7 +170,7 @@ impl GpuSilhouettes {
             ctx,
             &mut self.vertices,
             "smoothies",
-            halves * capacity * VERTEX_BYTES,
+            kinds * capacity * VERTEX_BYTES,
             storage | vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
@@ -188,7 +190,7 @@ impl GpuSilhouettes {
         // Slot 0 holds the one copy of the output (earlier frames may still draw from it: the
         // barriers below order this frame's writes after their reads).
         let (vertices, args) = (self.vertices.as_ref().expect("ensured").range(0), self.args.range(0));
-        let vertices = vk::DescriptorBufferInfo { range: halves * capacity * VERTEX_BYTES, ..vertices };
+        let vertices = vk::DescriptorBufferInfo { range: kinds * capacity * VERTEX_BYTES, ..vertices };
         let args = vk::DescriptorBufferInfo { range: DRAWS_BYTES, ..args };
         let far = receivers.far;
         let ground = receivers.ground.map_or(Vec4::ZERO, |g| g.extend(1.0));
@@ -232,11 +234,11 @@ impl GpuSilhouettes {
         // finish both before this frame's.
         buffer_barrier(ctx, cmd, BufferAccess::INDIRECT_DRAW, BufferAccess::TRANSFER_WRITE);
         buffer_barrier(ctx, cmd, BufferAccess::COMPUTE_READ_WRITE, BufferAccess::TRANSFER_WRITE);
-        // No vertices yet: each half of the buffer holds one kind, the outer smoothies and the
-        // inner quads, those away from corners appended from its start, those near them from its
-        // end back (silhouettes.comp's quad).
+        // No vertices yet: each third of the buffer holds one kind, the outer smoothies, the
+        // inner quads and the partial silhouettes' inner quads, those away from corners appended
+        // from its start, those near them from its end back (silhouettes.comp's quad).
         let cap = capacity as u32;
-        let draws = [0, cap, cap, 2 * cap].map(|first| [0, 1, first, 0]);
+        let draws = [0, cap, cap, 2 * cap, 2 * cap].map(|first| [0, 1, first, 0]);
         update_buffer(ctx, cmd, args, bytes_of(&draws));
         buffer_barrier(ctx, cmd, BufferAccess::TRANSFER_WRITE, BufferAccess::COMPUTE_READ_WRITE);
         for (i, &at) in meshes.iter().enumerate() {

@@ -301,6 +301,35 @@ pub struct CornerScene {
     pub truth: std::ops::RangeInclusive<f32>,
 }
 
+/// A thick slab (0.6 m wide, 1.3 m tall, from 1 m up) under a light of radius 0.5 m 5 m straight
+/// above it: its sides, seen edge-on from x = ±0.3 m, turn their backs to the light's centre and
+/// their faces to its rim. The silhouette from the centre is the top rim, whose inner half
+/// alone would reach 0.43 m in from its hard edge (x = 0.556 m); but a point under the side's
+/// plane (x < 0.3 m) sees only the light beyond it, for which the silhouette is the bottom rim,
+/// lower, with the narrower penumbra: the truth's umbra begins 0.31 m in, at x = 0.25 m (the
+/// ray from the light's rim past the bottom rim). Seen from above and aside at 128², the middle
+/// column runs across the near side's penumbra: from the hard edge (V = ½) inward to V = 0.02,
+/// `technique`'s inner half (with `sets`) must span within 20 % of the reference's.
+pub fn thick_slab_s_inner_half(technique: &str, sets: &[(&str, &str)]) {
+    let s = scene(
+        "[camera]\nposition = [2.35, 2.0, 0.0]\ntarget = [0.35, 0.0, 0.0]\nfov_y_deg = 20.0\n\
+         [light]\nposition = [0.0, 5.0, 0.0]\nradius = 0.5\n[ground]\nheight = 0.0\n\
+         [[object]]\nshape = \"box\"\nsize = [0.6, 1.3, 4.0]\nposition = [0.0, 1.65, 0.0]\n",
+    );
+    let mut e = engine();
+    let [v, truth] = [render_with(&mut e, &s, technique, sets, 128), reference(&mut e, &s, 128)];
+    finish(e);
+    // Up the middle column from the near (lit) ground: the hard edge, then the inner half.
+    let column = |c: &Capture| (0..c.height).rev().map(|y| c.visibility_at(c.width / 2, y)).collect::<Vec<_>>();
+    let inner = |v: &[f32]| {
+        let edge = v.iter().position(|&v| v < 0.5).expect("a hard edge in view");
+        v[edge..].iter().take_while(|&&v| v >= 0.02).count() as f32
+    };
+    let (got, want) = (inner(&column(&v)), inner(&column(&truth)));
+    assert!(want >= 15.0, "the reference's inner half spans {want} px");
+    assert!((got - want).abs() <= 0.2 * want, "{technique} {sets:?}: inner half {got} px, the reference's {want} px");
+}
+
 /// A plate's corner (half size 1, 1 m up, the light 6 m up, radius 0.5): its hard shadow's
 /// corner at (1.2, 0) sees the light cut by both edges' lines, ¾ of it, where either edge alone
 /// says ½ (the footprint is 0.2 m across, 0.8 m seen: 32 px of 128).
