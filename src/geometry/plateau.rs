@@ -1025,7 +1025,7 @@ fn unlit_boundary_edges<'a>(caster: &'a Caster<'_>, facing: &'a [bool]) -> impl 
 mod tests {
     use super::*;
     use crate::geometry::EdgeAdjacency;
-    use crate::geometry::silhouette::FacePlanes;
+    use crate::geometry::silhouette::{FacePlanes, TestMesh};
     use proptest::prelude::*;
 
     fn circle(x: f32, y: f32, r: f32) -> Cone {
@@ -1462,14 +1462,10 @@ mod tests {
     /// where the top rims' inner halves end, ±(0.556 − 0.426) m: k = 1.96. Outer only, none.
     #[test]
     fn a_thick_slab_s_bottom_rims_narrow_its_inner_halves() {
-        let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(0.6, 1.3, 4.0));
-        let adjacency = EdgeAdjacency::build(&triangles);
-        let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
-        let planes = FacePlanes::new(&slab, &triangles);
-        let model = Mat4::from_translation(Vec3::Y * 1.65);
+        let (slab, model) = TestMesh::thick_slab();
         let at = |penumbra| {
             let (ground, light) = (ReceiverPlane::ground(0.0), physical(Vec3::Y * 5.0, 0.5, penumbra));
-            caster_sides(&ground, &light, (&caster, &planes), &model, EdgeSource::Silhouettes, 2.0)
+            caster_sides(&ground, &light, (&slab.caster(), &slab.planes), &model, EdgeSource::Silhouettes, 2.0)
         };
         let outer = at(Penumbra::Outer);
         assert!(outer.partial.is_empty() && outer.partial_inner.is_empty());

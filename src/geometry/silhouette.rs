@@ -254,6 +254,34 @@ fn turning(p: [f32; 2], cos: f32, radius: f32) -> [bool; 2] {
     })
 }
 
+/// A mesh and what the silhouette finders take of it, for the geometry modules' tests.
+#[cfg(test)]
+pub(crate) struct TestMesh {
+    pub positions: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub adjacency: EdgeAdjacency,
+    pub planes: FacePlanes,
+}
+
+#[cfg(test)]
+impl TestMesh {
+    pub fn new((positions, triangles): super::shapes::Shape) -> Self {
+        let adjacency = EdgeAdjacency::build(&triangles);
+        let planes = FacePlanes::new(&positions, &triangles);
+        TestMesh { positions, triangles, adjacency, planes }
+    }
+
+    pub fn caster(&self) -> Caster<'_> {
+        Caster { positions: &self.positions, triangles: &self.triangles, adjacency: &self.adjacency }
+    }
+
+    /// The partial silhouettes' thick slab: 0.6 m wide (x), 1.3 m tall, 4 m long (z), standing
+    /// from 1 m up (its model matrix).
+    pub fn thick_slab() -> (Self, Mat4) {
+        (TestMesh::new(super::shapes::cuboid(Vec3::new(0.6, 1.3, 4.0))), Mat4::from_translation(Vec3::Y * 1.65))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Quat;

@@ -990,7 +990,7 @@ fn wedge(out: &mut Vec<SmoothieVertex>, n: [Vec2; 2], m: Vec2, k: f32, at: impl 
 mod tests {
     use super::*;
     use crate::geometry::EdgeAdjacency;
-    use crate::geometry::silhouette::partial_silhouettes;
+    use crate::geometry::silhouette::{TestMesh, partial_silhouettes};
     use proptest::prelude::*;
 
     /// A unit plate at `height`: positions, triangles and their adjacency.
@@ -1536,12 +1536,9 @@ mod tests {
     /// carrying the top rim's depth 2.7 and the inward normal. Outer only, nothing.
     #[test]
     fn a_thick_slab_s_bottom_rims_narrow_its_inner_halves() {
-        let (slab, triangles) = crate::geometry::shapes::cuboid(Vec3::new(0.6, 1.3, 4.0));
-        let adjacency = EdgeAdjacency::build(&triangles);
-        let caster = Caster { positions: &slab, triangles: &triangles, adjacency: &adjacency };
-        let planes = FacePlanes::new(&slab, &triangles);
-        let (model, light) = (Mat4::from_translation(Vec3::Y * 1.65), Vec3::Y * 5.0);
-        let partial = partial_silhouettes(&caster, &planes, &planes.light_facing(&model, light), &model, light, 0.5);
+        let ((slab, model), light) = (TestMesh::thick_slab(), Vec3::Y * 5.0);
+        let (caster, planes) = (slab.caster(), &slab.planes);
+        let partial = partial_silhouettes(&caster, planes, &planes.light_facing(&model, light), &model, light, 0.5);
         // Looking down from the light: view (x, y, z) = world (x, z, 5 − y).
         let view =
             Mat4::from_cols(glam::Vec4::X, -glam::Vec4::Z, glam::Vec4::Y, glam::Vec4::new(0.0, 0.0, 5.0, 1.0)) * model;
