@@ -659,10 +659,11 @@ void partial_silhouette(uint i) {
             continue;
         }
         // Where the umbra begins along the inward normal, against the turned vertex's (the
-        // silhouette's umbra); the quad carries the silhouette's depth there, and the inward
-        // normal, where a corner's vertex and normals go.
+        // silhouette's umbra), on an edge that spans the light's footprint; the quad carries the
+        // silhouette's depth there, and the inward normal, where a corner's vertex and normals go.
         float hold = dot(normal, tc) + sc * reach(pc.z, far);
-        if (hold - max(dot(normal, ta) + sa * ka, dot(normal, tb) + sb * kb) > needed) {
+        bool spans = distance(ta, tb) >= 2.0 * max(sa * ka, sb * kb);
+        if (spans && hold - max(dot(normal, ta) + sa * ka, dot(normal, tb) + sb * kb) > needed) {
             // Past its own umbra's start it still hides the whole light, as far as the
             // silhouette's inner half reaches: the quad reaches there, its alpha past 1.
             float da = clamp(hold - dot(normal, ta), sa * ka, MAX_INNER_REACH * sa * ka);
