@@ -870,10 +870,12 @@ fn outward(ca: &Cone, cb: &Cone, inside: Vec2) -> Vec2 {
 ///   of the light in front of its turned face, the part a receiver inside the hard shadow still
 ///   sees, it is the silhouette, with the narrower penumbra. Its sheet runs inward and goes to
 ///   `partial_inner`, drawn only over its own caster's hard shadow and blended by max, so that
-///   it only darkens there too. Each edge's half plane lets through at least what the caster
-///   does, so the darkest of them is the nearest to the truth: a thick slab's inner half spans
-///   the way from its top rim's hard edge to its bottom rim's umbra, narrower than the top
-///   rim's alone.
+///   it only darkens there too. From such a receiver the silhouette's half plane lets through
+///   more than the caster does (the caster reaches past it, to the lower edge), and the lower
+///   edge is the caster's outline, exact where it runs straight across the light's footprint,
+///   so the darkest of them is the nearest to the truth: a thick slab's inner half spans the
+///   way from its top rim's hard edge to its bottom rim's umbra, narrower than the top rim's
+///   alone.
 ///
 /// [`partial_silhouettes`]: super::silhouette::partial_silhouettes
 pub fn partial_sides(

@@ -665,8 +665,10 @@ fn near_corner(v: SmoothieVertex, c: Option<ShadowCorner>) -> SmoothieVertex {
 ///   `partial_inner`, with the caster's depth range as an inner quad's, its inward normal and
 ///   the turned vertex's depth, the silhouette's there (see [`SmoothieVertex::cx`]). The
 ///   smoothie pass draws them last and blends their alphas by max, converted to the
-///   silhouette's depth, so they only darken: each edge's half plane lets through at least what
-///   the caster does, so the darkest of them is the nearest to the truth.
+///   silhouette's depth, so they only darken. From such a receiver the silhouette's half plane
+///   lets through more than the caster does (the caster reaches past it, to the lower edge),
+///   and the lower edge is the caster's outline, exact where it runs straight across the light's
+///   footprint: hence the darker of the two, and only edges that span the footprint.
 pub fn partial_smoothies(
     view: &Mat4,
     caster: &Caster<'_>,
@@ -709,11 +711,11 @@ pub fn partial_smoothies(
             continue;
         }
         // Where the umbra begins along the inward normal, on the farthest receiver, against the
-        // turned vertex's. Its straight half plane bounds what a receiver sees only where the
-        // edge spans the light's footprint there (2·t·k across): a shorter one, as the rings of
-        // a round caster are, leaves the light past its ends, where the outline turns away (the
-        // sphere's inner half went 0.013 too dark on average where it moved: penumbra RMSE
-        // 0.01500 → 0.01531; with this, as before).
+        // turned vertex's. Its straight half plane is what a receiver sees only where the edge
+        // spans the light's footprint there (2·t·k across): past the ends of a shorter one, as
+        // a round caster's rings are, the outline turns away and lets more light by (without
+        // this, the sphere's inner half went 0.013 too dark on average where it moved: penumbra
+        // RMSE 0.01500 → 0.01531).
         let umbra = |p: Vec2, z: f32| normal.dot(p) + size.at(z) * reach(z, far);
         if umbra(pc, zc) - umbra(pa, za).max(umbra(pb, zb)) <= PARTIAL_GAIN * half || pa.distance(pb) < 2.0 * half {
             continue;

@@ -45,8 +45,8 @@
 //! thick slab's bottom rim: the truth's inner half 0.31 m where the top rim's alone is 0.43 m).
 //! Such edges add the inner half of their own sheet, drawn last over their caster's hard shadow
 //! and blended by max, so it only darkens: min over the silhouette's sides (the nearest edge),
-//! then max over the edges that lie under it (each edge's half plane lets through at least what
-//! the caster does). Only where the mask says the caster reaches a penumbra's width beyond the
+//! then max over the edges that lie under it (from there the silhouette's half plane lets
+//! through more than the caster does, the lower edge's about what it does). Only where the mask says the caster reaches a penumbra's width beyond the
 //! fragment, straight in and to either side: a caster narrower than the penumbra, or a corner,
 //! lets light past that no straight edge's half plane knows of. Measured (512², lavapipe, against
 //! the reference at 256 samples, penumbra RMSE without → with): sphere 0.0138 → 0.0135, torus
