@@ -627,7 +627,7 @@ void partial_silhouette(uint i) {
         return;
     }
     along = normalize(along);
-    for (int k = 0; k < 2; k++) {
+    [[dont_unroll]] for (int k = 0; k < 2; k++) {
         int j = 1 - k;
         if (!(line || abs(p[k]) < radius && (p[j] - c * p[k]) * p[j] > 0.0)) {
             continue;
@@ -649,30 +649,37 @@ void partial_silhouette(uint i) {
         vec2 tc = pc.xy / pc.z;
         Vertex q[4];
         edge_quad(ta, tb, pa.z, pb.z, normal, false, q);
+        // One quad() for both kinds, in a loop kept rolled: each call is inlined, and llvmpipe's
+        // compile time grows with them (a call per kind took its first compile from 275 to 368 s).
+        Inner inner;
+        Corner corner = NO_CORNER;
         if (p[0] > 0.0) {
             // How far out its smoothie reaches, against the turned vertex's.
             float gain = max(dot(normal, ta) + sa, dot(normal, tb) + sb) - (dot(normal, tc) + sc);
-            if (gain > needed) {
-                float behind = max(max(pa.z, pb.z), pc.z);
-                quad(q, Inner(vec2(0.0), vec2(behind, -1.0), false), NO_CORNER, KEEP_ALL);
+            if (gain <= needed) {
+                continue;
             }
-            continue;
-        }
-        // Where the umbra begins along the inward normal, against the turned vertex's (the
-        // silhouette's umbra), on an edge that spans the light's footprint; the quad carries the
-        // silhouette's depth there, and the inward normal, where a corner's vertex and normals go.
-        float hold = dot(normal, tc) + sc * reach(pc.z, far);
-        bool spans = distance(ta, tb) >= 2.0 * max(sa * ka, sb * kb);
-        if (spans && hold - max(dot(normal, ta) + sa * ka, dot(normal, tb) + sb * kb) > needed) {
+            inner = Inner(vec2(0.0), vec2(max(max(pa.z, pb.z), pc.z), -1.0), false);
+        } else {
+            // Where the umbra begins along the inward normal, against the turned vertex's (the
+            // silhouette's umbra), on an edge that spans the light's footprint; the quad carries
+            // the silhouette's depth there, and the inward normal, where a corner's vertex and
+            // normals go.
+            float hold = dot(normal, tc) + sc * reach(pc.z, far);
+            bool spans = distance(ta, tb) >= 2.0 * max(sa * ka, sb * kb);
+            if (!spans || hold - max(dot(normal, ta) + sa * ka, dot(normal, tb) + sb * kb) <= needed) {
+                continue;
+            }
             // Past its own umbra's start it still hides the whole light, as far as the
             // silhouette's inner half reaches: the quad reaches there, its alpha past 1.
             float da = clamp(hold - dot(normal, ta), sa * ka, MAX_INNER_REACH * sa * ka);
             float db = clamp(hold - dot(normal, tb), sb * kb, MAX_INNER_REACH * sb * kb);
             q[2] = Vertex(tb + normal * db, pb.z, vec2(sb > 0.0 ? db / sb : 0.0, 0.0), vec2(0.0), weight(sb), 1.0);
             q[3] = Vertex(ta + normal * da, pa.z, vec2(sa > 0.0 ? da / sa : 0.0, 0.0), vec2(0.0), weight(sa), 0.0);
-            quad(q, Inner(vec2(0.0), params.size.yw, true), Corner(vec2(pc.z, 0.0), vec4(normal, 0.0, 0.0), 0.0, vec3(0.0)),
-                 KEEP_ALL);
+            inner = Inner(vec2(0.0), params.size.yw, true);
+            corner = Corner(vec2(pc.z, 0.0), vec4(normal, 0.0, 0.0), 0.0, vec3(0.0));
         }
+        quad(q, inner, corner, KEEP_ALL);
     }
 }
 
