@@ -8,12 +8,12 @@
 
 mod common;
 
-use common::{engine, finish, suite_scene};
+use common::{engine, finish, realtime_runs, suite_scene};
 use std::sync::Arc;
 
 use softshadow::renderer::DEFAULT_TIMING_HISTORY;
 use softshadow::scene::Mesh;
-use softshadow::technique::{Kind, Params, TECHNIQUES, find};
+use softshadow::technique::{Kind, Params, TECHNIQUES};
 use softshadow::{Engine, FrameSettings};
 
 const FRAMES_PER_TECHNIQUE: usize = 200;
@@ -56,14 +56,7 @@ fn two_thousand_frames_grow_nothing() {
 fn streamed_meshes_are_let_go() {
     let mut e = engine();
     let mut scene = suite_scene("sphere");
-    let mut runs: Vec<(&str, Params)> =
-        TECHNIQUES.iter().filter(|t| t.kind == Kind::Realtime).map(|t| (t.name, Params::defaults(t))).collect();
-    for name in ["smoothie", "shadow-volume"] {
-        let mut params = Params::defaults(find(name).unwrap());
-        params.set("gpu_silhouettes", "1").unwrap();
-        runs.push((name, params));
-    }
-    for (name, params) in runs {
+    for (name, params) in realtime_runs() {
         let settings = FrameSettings { width: 32, height: 32, params };
         let mut live = Vec::new();
         for _ in 0..4 {

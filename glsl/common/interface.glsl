@@ -30,8 +30,9 @@ struct LightView {
     mat4 view_proj;  // world -> light clip
     vec4 extent;     // tangent-space window: x0, y0, x1, y1 (x/z and y/z of the frustum's sides)
     vec4 bias;       // constant (texels), slope (texels), normal offset (texels), map size
-    vec4 kernel;     // PCF: taps, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
-                     // PCSS: filter taps, light radius (world), frustum near depth, blocker taps
+    vec4 kernel;     // PCF: unused, kernel radius (texels, or world units: RADIUS_IN_WORLD), unused, unused
+                     // PCSS: unused, light radius (world), frustum near depth, unused (the taps:
+                     // shadow_map/resolve.frag's constants)
                      // smoothie: buffer size, an empty map texel's depth, ground height, light height
     vec4 depths;     // the frustum's linear depth range: near, far, log2(far / near); the map's rounding
 };
@@ -57,7 +58,7 @@ struct PlateauView {
 };
 
 // One caster's silhouette dispatch (glsl/smoothie/silhouettes.comp). 256 bytes, so an array of
-// them can be bound one element at a time as a uniform buffer.
+// them can be bound one element at a time (a storage buffer there: see why in that shader).
 struct SilhouetteParams {
     mat4 model_view;  // object -> light view (+z away from the light)
     vec4 size;        // x: t, or scale * light radius with PHYSICAL_SIZE (t = x / depth); z: farthest receiver;

@@ -74,18 +74,16 @@ float pcf_disk_plane(sampler2D map, LightView light, ReceiverPlane r, vec2 centr
 // PCSS: average the depths of the blockers in the region the light could be hidden from,
 // estimate the penumbra from similar triangles, and PCF over it (Fernando 2005).
 // `p`, `n`: the receiver and its facet normal (world); `radius`: the light's, as seen from the
-// projection centre (apparent_radius). light.kernel: filter taps, light radius (world), the
-// frustum's near depth, blocker taps.
+// projection centre (apparent_radius); `taps`, `blocker_taps`: the filter's and the search's.
+// light.kernel: -, light radius (world), the frustum's near depth, -.
 //
 // Both the search and the filter reach far beyond the few texels a depth bias covers, so on a
 // surface slanted to the light they would find the receiver's own surface in front of its one
 // depth: a lit face of a caster came out at V ~ 0.7 (issue 19). Both test map texels against
 // the receiver's tangent plane instead (ReceiverPlane, glsl/common/shadow.glsl).
-float pcss(sampler2D map, LightView light, ShadowLookup l, vec3 p, vec3 n, float radius) {
+float pcss(sampler2D map, LightView light, ShadowLookup l, vec3 p, vec3 n, float radius, int taps, int blocker_taps) {
     float size = light.bias.w;
     float near = light.kernel.z;
-    int taps = max(int(light.kernel.x), 1);
-    int blocker_taps = max(int(light.kernel.w), 1);
     float per_tangent = texels_per_tangent(light).x;
     ReceiverPlane r = receiver_plane(light, p, n);
     float z = r.p.z;

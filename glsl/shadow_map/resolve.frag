@@ -10,6 +10,12 @@
 layout(constant_id = 0) const uint FILTER = FILTER_HARD;
 // pcf's `radius_world`: the disk radius is in world units at the receiver, not texels.
 layout(constant_id = 1) const bool RADIUS_IN_WORLD = false;
+// The disk's taps (pcf's `taps`, pcss's `filter_samples`) and pcss's blocker search's. Constants,
+// not uniforms: lavapipe inlines a uniform a loop's end depends on and compiles the shader again
+// for each new value of any uniform it inlines with it, which for pcss took every frame whose
+// light view moved (190 ms a frame at 32² with a moving caster).
+layout(constant_id = 2) const int TAPS = 16;
+layout(constant_id = 3) const int BLOCKER_TAPS = 16;
 
 layout(set = 0, binding = 0) uniform Frame { FrameGlobals frame; };
 layout(set = 0, binding = 1) uniform Light { LightView light; };
@@ -45,7 +51,7 @@ void main() {
             float z = (light.view * vec4(s.p, 1.0)).z;
             radius *= texels_per_tangent(light).x / z;
         }
-        out_visibility = pcf_disk(shadow_map, light, l, radius, max(int(light.kernel.x), 1));
+        out_visibility = pcf_disk(shadow_map, light, l, radius, TAPS);
     } else if (FILTER == FILTER_BICUBIC) {
         out_visibility = pcf_bicubic(shadow_map, light, l);
     } else {
@@ -53,6 +59,6 @@ void main() {
         // part of the light below its tangent plane is taken out here (the soft hides_itself).
         float self_lit = in_front_of_itself(s, frame.light.xyz, light.kernel.y);
         float radius = apparent_radius(light, frame.light.xyz, s.p, light.kernel.y);
-        out_visibility = self_lit * pcss(shadow_map, light, l, s.p, s.n, radius);
+        out_visibility = self_lit * pcss(shadow_map, light, l, s.p, s.n, radius, TAPS, BLOCKER_TAPS);
     }
 }

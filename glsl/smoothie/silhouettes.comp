@@ -12,7 +12,10 @@ layout(local_size_x = COMPUTE_GROUP) in;
 // Smoothie size from the light's angular radius at the blocker (t = scale · R / b), or fixed.
 layout(constant_id = 0) const bool PHYSICAL_SIZE = true;
 
-layout(set = 0, binding = 0) uniform Params { SilhouetteParams params; };
+// A storage buffer, not a uniform one: lavapipe inlines the uniforms a branch or a loop's end
+// depends on alone, compiling the shader again for each new value, and here some move with the
+// caster (a recompile every frame, 5 s each: tests/shader_variants.rs).
+layout(std430, set = 0, binding = 0) readonly buffer Params { SilhouetteParams params; };
 layout(std430, set = 0, binding = 1) readonly buffer Positions { vec4 positions[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Triangles { uvec4 triangles[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Edges { uvec4 edges[]; }; // v0, v1, face0, face1
@@ -132,25 +135,22 @@ bool append(Inner inner, Corner c, uint count, out uint at) {
     return at >= kind * params.counts.z && at <= (kind + 1u) * params.counts.z; // from the half's end back
 }
 
-// Six vertices, two triangles: the quad q0 q1 q2 q3, keeping `keep` of its edge.
-void quad(Vertex q[4], Inner inner, Corner c, vec2 keep) {
-    uint at;
-    if (append(inner, c, 6u, at)) {
+// The quad q0 q1 q2 q3 as two triangles, or its first three vertices alone, keeping `keep` of
+// its edge. Its vertices are written in a loop kept rolled, and its callers call it from as few
+// places as they can: each call is inlined, and llvmpipe's first compile grows with every store
+// inlined (six vertices' stores at each of 26 call sites took it to 50 s, against 4.5 s now).
+void primitive(Vertex q[4], bool triangle, Inner inner, Corner c, vec2 keep) {
+    uint count = triangle ? 3u : 6u, at;
+    if (append(inner, c, count, at)) {
         const int order[6] = int[6](0, 1, 2, 0, 2, 3);
-        for (int k = 0; k < 6; k++) {
-            put(at + uint(k), q[order[k]], inner, c, keep);
+        [[dont_unroll]] for (uint k = 0u; k < count; k++) {
+            put(at + k, q[order[k]], inner, c, keep);
         }
     }
 }
 
-// One triangle.
-void triangle(Vertex t[3], Inner inner, Corner c, vec2 keep) {
-    uint at;
-    if (append(inner, c, 3u, at)) {
-        for (int k = 0; k < 3; k++) {
-            put(at + uint(k), t[k], inner, c, keep);
-        }
-    }
+void quad(Vertex q[4], Inner inner, Corner c, vec2 keep) {
+    primitive(q, false, inner, c, keep);
 }
 
 // a + (b − a)·u, as src/geometry/smoothie.rs's between takes it.
@@ -220,7 +220,7 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
                                         between(q[3], q[2], g0));
             Corner c = j == 0 ? corners[0] : (j == 2 ? corners[1] : NO_CORNER);
             quad(piece, inner, c, keep);
-            triangle(Vertex[3](q[0], q[1], sliver), inner, c, keep);
+            primitive(Vertex[4](q[0], q[1], sliver, sliver), true, inner, c, keep);
         }
     }
 }
@@ -649,8 +649,7 @@ void partial_silhouette(uint i) {
         vec2 tc = pc.xy / pc.z;
         Vertex q[4];
         edge_quad(ta, tb, pa.z, pb.z, normal, false, q);
-        // One quad() for both kinds, in a loop kept rolled: each call is inlined, and llvmpipe's
-        // compile time grows with them (a call per kind took its first compile from 275 to 368 s).
+        // One quad() for both kinds, in a loop kept rolled (see primitive).
         Inner inner;
         Corner corner = NO_CORNER;
         if (p[0] > 0.0) {
@@ -726,17 +725,13 @@ void main() {
     if (!s.sided) {
         return;
     }
-    Vertex outer[4];
+    Vertex outer[4], inner[4];
     edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], s.normal, false, outer);
-    if (params.counts.w == 0u) {
-        quad(outer, OUTER, NO_CORNER, KEEP_ALL);
-        return;
-    }
-    // Centred, the inner quad too, mirrored over the blocker (issue 20), both in pieces near
-    // the hard shadow's corners.
-    Vertex inner[4];
     edge_quad(s.t[0], s.t[1], s.z[0], s.z[1], -s.normal, true, inner);
     vec2 cuts = corner_cuts(outer, inner, corners);
-    edge_pieces(outer, OUTER, corners, cuts);
-    edge_pieces(inner, Inner(s.normal, params.size.yw, false), corners, cuts);
+    // Centred, the inner quad too, mirrored over the blocker (issue 20), both in pieces near
+    // the hard shadow's corners (outer only, there are none).
+    [[dont_unroll]] for (int side = 0; side < (params.counts.w == 0u ? 1 : 2); side++) {
+        edge_pieces(side == 0 ? outer : inner, side == 0 ? OUTER : Inner(s.normal, params.size.yw, false), corners, cuts);
+    }
 }

@@ -188,7 +188,7 @@ mod tests {
 
     #[test]
     fn storage_buffers_are_told_from_uniform_buffers() {
-        let r = reflect("silhouettes", shaders::SMOOTHIE_SILHOUETTES_COMP.words).unwrap();
+        let r = reflect("silhouettes", shaders::SHADOW_VOLUME_SILHOUETTES_COMP.words).unwrap();
         let kinds: Vec<_> = r.bindings.iter().map(|b| b.kind).collect();
         assert_eq!(kinds[0], Binding::Uniform);
         assert!(kinds[1..].iter().all(|k| *k == Binding::Storage), "{kinds:?}");

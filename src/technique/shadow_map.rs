@@ -341,14 +341,22 @@ enum Filter {
     Pcss = FILTER_PCSS,
 }
 
+/// The disk's taps and the blocker search's: the resolve's `TAPS` and `BLOCKER_TAPS`, constants
+/// (see there why not uniforms).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Taps {
+    filter: u32,
+    blockers: u32,
+}
+
 /// `shadow-map`, `pcf` and `pcss`: one [`ShadowMapPass`], then one resolve skeleton
 /// specialised by the filter.
 pub struct ShadowMap {
     technique: &'static TechniqueInfo,
     pass: ShadowMapPass,
-    /// Resolve pipelines made so far, by filter and whether the disk radius is in world units
-    /// (`pcf` knobs switch both).
-    resolves: Variants<(Filter, bool)>,
+    /// Resolve pipelines made so far, by filter, whether the disk radius is in world units
+    /// (`pcf` knobs switch both) and the taps.
+    resolves: Variants<(Filter, bool, Taps)>,
     /// The V target's format, which the resolves write.
     visibility: vk::Format,
 }
@@ -364,20 +372,22 @@ impl ShadowMap {
         Ok(Box::new(ShadowMap::new(ctx, technique, visibility)?))
     }
 
-    /// The filter and its `LightView.filter` parameters for this frame's knobs.
-    fn filter(&self, params: &Params, frame: &FrameInputs<'_>, frustum: &LightFrustum) -> (Filter, Vec4) {
+    /// The filter, its `LightView.kernel` parameters for this frame's knobs, and its taps.
+    fn filter(&self, params: &Params, frame: &FrameInputs<'_>, frustum: &LightFrustum) -> (Filter, Vec4, Taps) {
+        let none = Taps { filter: 1, blockers: 1 };
         match self.technique.name {
-            name if name == PCF.name && params.is_on(&BICUBIC) => (Filter::Bicubic, Vec4::ZERO),
+            name if name == PCF.name && params.is_on(&BICUBIC) => (Filter::Bicubic, Vec4::ZERO, none),
             name if name == PCF.name => {
-                let [taps, radius] = [TAPS, RADIUS].map(|k| params.get(&k) as f32);
-                (Filter::Disk, Vec4::new(taps, radius, 0.0, 0.0))
+                let taps = Taps { filter: params.get(&TAPS) as u32, ..none };
+                (Filter::Disk, Vec4::new(0.0, params.get(&RADIUS) as f32, 0.0, 0.0), taps)
             }
             name if name == PCSS.name => {
                 let radius = frame.scene.light.radius * params.get(&LIGHT_SIZE_SCALE) as f32;
-                let [taps, blockers] = [FILTER_SAMPLES, BLOCKER_SAMPLES].map(|k| params.get(&k) as f32);
-                (Filter::Pcss, Vec4::new(taps, radius, frustum.near, blockers))
+                let taps =
+                    Taps { filter: params.get(&FILTER_SAMPLES) as u32, blockers: params.get(&BLOCKER_SAMPLES) as u32 };
+                (Filter::Pcss, Vec4::new(0.0, radius, frustum.near, 0.0), taps)
             }
-            _ => (Filter::Hard, Vec4::ZERO),
+            _ => (Filter::Hard, Vec4::ZERO, none),
         }
     }
 }
@@ -389,13 +399,18 @@ impl Technique for ShadowMap {
         };
         let size = params.get(&SHADOW_MAP_SIZE) as u32;
         let bias = texel_biases(params);
-        let (filter, filter_params) = self.filter(params, frame, &frustum);
+        let (filter, filter_params, taps) = self.filter(params, frame, &frustum);
         self.pass.record(frame, &frustum, size, bias, filter_params, None)?;
 
         let world = self.technique.name == PCF.name && params.is_on(&RADIUS_WORLD);
         let format = self.visibility;
-        let pipeline = self.resolves.get((filter, world), |&(filter, world)| {
-            let constants = [("FILTER", filter as u32), ("RADIUS_IN_WORLD", world as u32)];
+        let pipeline = self.resolves.get((filter, world, taps), |&(filter, world, taps)| {
+            let constants = [
+                ("FILTER", filter as u32),
+                ("RADIUS_IN_WORLD", world as u32),
+                ("TAPS", taps.filter),
+                ("BLOCKER_TAPS", taps.blockers),
+            ];
             let desc = Fullscreen::new("resolve", &shaders::SHADOW_MAP_RESOLVE_FRAG, format).constants(&constants);
             Pipeline::fullscreen(frame.ctx, &desc)
         })?;

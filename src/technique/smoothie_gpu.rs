@@ -174,13 +174,7 @@ impl GpuSilhouettes {
             storage | vk::BufferUsageFlags::VERTEX_BUFFER,
         )?;
         let params_bytes = casters.len().max(1) as u64 * PARAMS_BYTES;
-        PerFrame::ensure(
-            ctx,
-            &mut self.params,
-            "silhouette params",
-            params_bytes,
-            vk::BufferUsageFlags::UNIFORM_BUFFER,
-        )?;
+        PerFrame::ensure(ctx, &mut self.params, "silhouette params", params_bytes, storage)?;
 
         let partial_radius = if centred { light_radius } else { 0.0 };
         let (scale, behind, physical) = match size {

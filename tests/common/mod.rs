@@ -9,7 +9,7 @@ pub mod xvfb;
 use softshadow::gpu::ContextOptions;
 use softshadow::measure::PENUMBRA;
 use softshadow::scene::Scene;
-use softshadow::technique::{Params, find};
+use softshadow::technique::{Kind, Params, TECHNIQUES, find};
 use softshadow::{Capture, Engine, FrameSettings};
 
 pub fn engine() -> Engine {
@@ -149,6 +149,19 @@ pub fn render_with(e: &mut Engine, s: &Scene, technique: &str, sets: &[(&str, &s
     frame.params = Params::defaults(find(technique).expect("a known technique"));
     frame.params.apply(sets.iter().copied()).expect("valid knobs");
     e.render_and_capture(s, &frame).expect("a rendered frame")
+}
+
+/// Every real-time technique at its defaults, then the smoothie and the shadow volumes on their
+/// compute paths (`gpu_silhouettes = 1`).
+pub fn realtime_runs() -> Vec<(&'static str, Params)> {
+    let mut runs: Vec<(&str, Params)> =
+        TECHNIQUES.iter().filter(|t| t.kind == Kind::Realtime).map(|t| (t.name, Params::defaults(t))).collect();
+    for name in ["smoothie", "shadow-volume"] {
+        let mut params = Params::defaults(find(name).unwrap());
+        params.set("gpu_silhouettes", "1").unwrap();
+        runs.push((name, params));
+    }
+    runs
 }
 
 pub fn settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
