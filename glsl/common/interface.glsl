@@ -103,7 +103,7 @@ struct ClassicView {
     vec4 plane_u;       // xyz
     vec4 plane_v;       // xyz
     vec4 window;        // u0, v0, u1, v1: the part of the plane a plan-view texture covers
-    vec4 params;        // blob: count, softness; projective texture: count
+    vec4 params;        // blob: -, softness (its count: the blobs' buffer's length); projective texture: count
 };
 
 // A blob (glsl/blob/resolve.frag): plane coordinates relative to `centre` times `to_unit`

@@ -20,7 +20,10 @@ void write_surface(vec3 world, vec3 g) {
     // Two-sided surfaces (plates, open meshes): shade the side that faces the camera.
     if (!gl_FrontFacing) n = -n;
     g = dot(g, g) > 0.0 ? normalize(g) : n;
-    vec3 to_camera = frame.camera_position.w > 0.5 ? frame.camera_position.xyz - world : -frame.camera_forward.xyz;
+    // A select, not a branch: lavapipe compiles a shader again whenever it meets a branch on
+    // uniforms alone with new uniforms bound (every frame), 65 ms a frame for this one uncached.
+    bool perspective = frame.camera_position.w > 0.5;
+    vec3 to_camera = mix(-frame.camera_forward.xyz, frame.camera_position.xyz - world, bvec3(perspective));
     if (dot(g, to_camera) < 0.0) g = -g;
     out_normal_role = vec4(g, in_albedo.a);
     out_shading = vec4(n * 0.5 + 0.5, 1.0);

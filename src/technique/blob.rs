@@ -102,16 +102,16 @@ impl Technique for Blobs {
             return clear_visibility(frame, visibility);
         }
         let ctx = frame.ctx;
-        let params = Vec4::new(blobs.len() as f32, params.get(&SOFTNESS) as f32, 0.0, 0.0);
+        let params = Vec4::new(0.0, params.get(&SOFTNESS) as f32, 0.0, 0.0);
         let view = ground::view(&plane, Vec4::ZERO, params);
         self.view.write(frame.slot, bytes_of(&view));
         let bytes: &[u8] = cast_slice(&blobs);
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let buffer = PerFrame::ensure(ctx, &mut self.blobs, "blobs", bytes.len() as u64, usage)?;
         buffer.write(frame.slot, bytes);
-        let inputs =
-            [&surface_inputs(frame, self.view.range(frame.slot))[..], &[Descriptor::Buffer(buffer.range(frame.slot))]]
-                .concat();
+        // Bound to this frame's blobs exactly: the resolve takes their count from its length.
+        let range = vk::DescriptorBufferInfo { range: bytes.len() as u64, ..buffer.range(frame.slot) };
+        let inputs = [&surface_inputs(frame, self.view.range(frame.slot))[..], &[Descriptor::Buffer(range)]].concat();
         resolve(frame, &self.resolve, visibility, &inputs)
     }
 
