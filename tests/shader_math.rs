@@ -56,33 +56,32 @@ fn disk_below(h: f64) -> f64 {
     1.0 - (h.acos() - h * (1.0 - h * h).sqrt()) / PI
 }
 
-/// The fraction of the unit disk in u·x ≥ d for both lines, u1 = (1, 0) and u2 at `delta`: a
-/// regular polygon of 20 000 sides clipped by both half planes (its area within 2e-8 of the
-/// disk's).
+/// The fraction of the unit disk in u·x ≥ d for both lines, u1 = (1, 0) and u2 at `delta`,
+/// integrated across u1: at x = cos θ the disk's chord is |y| ≤ sin θ, which the second line
+/// cuts to an interval, and the area is that length over dx = sin θ dθ, θ from 0 to acos d1
+/// (the midpoint rule in 100 000 steps: within 1e-7 of the disk, the length's kinks included).
 fn disk_in_both(d1: f64, d2: f64, delta: f64) -> f64 {
-    const SIDES: usize = 20_000;
-    let mut polygon: Vec<[f64; 2]> =
-        (0..SIDES).map(|k| 2.0 * PI * k as f64 / SIDES as f64).map(|a| [a.cos(), a.sin()]).collect();
-    for (u, d) in [([1.0, 0.0], d1), ([delta.cos(), delta.sin()], d2)] {
-        let side = |p: [f64; 2]| u[0] * p[0] + u[1] * p[1] - d;
-        let mut kept = Vec::with_capacity(polygon.len());
-        for (i, &p) in polygon.iter().enumerate() {
-            let q = polygon[(i + 1) % polygon.len()];
-            let (sp, sq) = (side(p), side(q));
-            if sp >= 0.0 {
-                kept.push(p);
-            }
-            if (sp >= 0.0) != (sq >= 0.0) {
-                let t = sp / (sp - sq);
-                kept.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
-            }
-        }
-        polygon = kept;
-    }
-    let n = polygon.len();
-    let twice: f64 =
-        (0..n).map(|i| polygon[i][0] * polygon[(i + 1) % n][1] - polygon[(i + 1) % n][0] * polygon[i][1]).sum();
-    0.5 * twice.abs() / PI
+    const STEPS: usize = 100_000;
+    let (cos, sin) = (delta.cos(), delta.sin());
+    let end = d1.clamp(-1.0, 1.0).acos();
+    let step = end / STEPS as f64;
+    let length = |theta: f64| {
+        let (x, half) = (theta.cos(), theta.sin());
+        // Where on the chord cos·x + sin·y = d2.
+        let at = (d2 - cos * x) / sin;
+        let (lo, hi) = if sin > 0.0 {
+            (at.max(-half), half)
+        } else if sin < 0.0 {
+            (-half, at.min(half))
+        } else if cos * x >= d2 {
+            (-half, half)
+        } else {
+            (0.0, 0.0)
+        };
+        (hi - lo).max(0.0)
+    };
+    let area: f64 = (0..STEPS).map(|k| (k as f64 + 0.5) * step).map(|t| length(t) * t.sin() * step).sum();
+    area / PI
 }
 
 /// Inputs spread over the functions' ranges: v across [0, 1] and toward both ends, where the
@@ -132,10 +131,10 @@ fn the_disk_edge_curve_s_inverse_is_its_inverse() {
     }
 }
 
-/// The corner's visibility, Green's theorem over the region's arcs and chords, is the area a
-/// clipped polygon gives, to 1e-3 of the light (a quarter of an 8-bit step).
+/// The corner's visibility, Green's theorem over the region's arcs and chords, is the area the
+/// integral across the disk gives, to 1e-3 of the light (a quarter of an 8-bit step).
 #[test]
-fn two_lines_leave_the_part_of_the_disk_a_clipped_polygon_does() {
+fn two_lines_leave_the_part_of_the_disk_the_integral_does() {
     let inputs = inputs();
     let results = on_the_gpu(&inputs);
     let worst = inputs
@@ -149,7 +148,7 @@ fn two_lines_leave_the_part_of_the_disk_a_clipped_polygon_does() {
         .unwrap();
     assert!(
         worst.0 <= 1e-3,
-        "disk_in_both(d1 {}, d2 {}, delta {}) = {}, the polygon's {}",
+        "disk_in_both(d1 {}, d2 {}, delta {}) = {}, the integral's {}",
         worst.1,
         worst.2,
         worst.3,
