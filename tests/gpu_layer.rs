@@ -6,6 +6,7 @@ mod common;
 
 use ash::vk;
 use common::embedder::Embedder;
+use common::{context, finish_context as finish};
 use gpu_allocator::MemoryLocation;
 use softshadow::Error;
 use softshadow::gpu::{
@@ -17,18 +18,6 @@ use softshadow::gpu::{
 const SIDE: u32 = 4;
 const TEXELS: usize = (SIDE * SIDE) as usize;
 const RGBA8: vk::Format = vk::Format::R8G8B8A8_UNORM;
-
-fn context() -> Context {
-    Context::headless(&ContextOptions { validation: true, device: None })
-        .expect("a Vulkan 1.3 device (lavapipe) with validation layers")
-}
-
-/// Destroys the context and fails on any validation error, objects left alive included.
-fn finish(mut ctx: Context) {
-    ctx.destroy();
-    let errors = ctx.validation_errors();
-    assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
-}
 
 fn readback(ctx: &Context, bytes: u64) -> Buffer {
     Buffer::new(ctx, "readback", bytes, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap()

@@ -3,11 +3,13 @@
 //! the disk-edge curve, which both centred techniques write near corners, and the part of the
 //! light's disk two edges' lines leave, which their corners are. With validation on.
 
+mod common;
+
 use ash::vk;
+use common::{context, finish_context};
 use gpu_allocator::MemoryLocation;
 use softshadow::gpu::{
-    Buffer, BufferAccess, Context, ContextOptions, Descriptor, FrameRing, Pipeline, Semaphores, buffer_barrier,
-    dispatch, shaders,
+    Buffer, BufferAccess, Descriptor, FrameRing, Pipeline, Semaphores, buffer_barrier, dispatch, shaders,
 };
 use std::f64::consts::PI;
 
@@ -23,8 +25,7 @@ struct Input {
 
 /// Runs corners.comp over `inputs` and returns (disk_below_inverse(v), disk_in_both) for each.
 fn on_the_gpu(inputs: &[Input]) -> Vec<[f32; 2]> {
-    let mut ctx = Context::headless(&ContextOptions { validation: true, device: None })
-        .expect("a Vulkan 1.3 device (lavapipe) with validation layers");
+    let ctx = context();
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let bytes: &[u8] = bytemuck::cast_slice(inputs);
     let mut input = Buffer::new(&ctx, "inputs", bytes.len() as u64, usage, MemoryLocation::CpuToGpu).unwrap();
@@ -44,9 +45,7 @@ fn on_the_gpu(inputs: &[Input]) -> Vec<[f32; 2]> {
     pipeline.destroy(&ctx);
     input.destroy(&ctx);
     output.destroy(&ctx);
-    ctx.destroy();
-    let errors = ctx.validation_errors();
-    assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
+    finish_context(ctx);
     results
 }
 

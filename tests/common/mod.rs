@@ -6,7 +6,7 @@ pub mod c;
 pub mod embedder;
 pub mod xvfb;
 
-use softshadow::gpu::ContextOptions;
+use softshadow::gpu::{Context, ContextOptions};
 use softshadow::measure::PENUMBRA;
 use softshadow::scene::Scene;
 use softshadow::technique::{Kind, Params, TECHNIQUES, find};
@@ -20,6 +20,19 @@ pub fn engine() -> Engine {
 /// Destroys the engine and fails the test on any validation error.
 pub fn finish(engine: Engine) {
     let errors = engine.finish();
+    assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
+}
+
+/// A headless context on lavapipe with validation on, for tests below the engine.
+pub fn context() -> Context {
+    Context::headless(&ContextOptions { validation: true, device: None })
+        .expect("a Vulkan 1.3 device (lavapipe) with validation layers")
+}
+
+/// Destroys the context and fails on any validation error, objects left alive included.
+pub fn finish_context(mut ctx: Context) {
+    ctx.destroy();
+    let errors = ctx.validation_errors();
     assert!(errors.is_empty(), "{} validation error(s):\n{}", errors.len(), errors.join("\n"));
 }
 
