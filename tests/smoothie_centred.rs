@@ -9,7 +9,7 @@ mod common;
 
 use common::{
     HIDDEN_IN_THE_SPHERE, as_accurate_as, crossing, engine, error_minimising_scale, finish, l_shaped_slab,
-    largest_difference, penumbra_pixels, plate_corner, reference, render_with, sees_at_the_corner, sphere_with,
+    largest_difference, penumbra_pixels, plate_corner, reference, render_with, scene, sees_at_the_corner, sphere_with,
     suite_scene, terminator_error, thick_slab_s_inner_half,
 };
 use softshadow::Capture;
@@ -275,6 +275,47 @@ fn interior_silhouettes_leave_no_bright_streak_in_the_umbra() {
         let brightest = brightest_in_umbra(&render_with(&mut e, &s, "smoothie", CENTRED, 128), &truth);
         eprintln!("{name}: brightest V in the truth's umbra {brightest:.3}");
         assert!(brightest <= 0.1, "{name}: V {brightest} inside the truth's umbra");
+    }
+    finish(e);
+}
+
+/// Close to the wingnut, in `default`'s pose and light, the lit top of a wing lies behind a reflex
+/// turn of its outline: the corner's two lines put the whole footprint there in their shadow,
+/// but the wing ends within it and the light's centre sees past (centred.glsl's
+/// `outside_lines`). Where the truth is lit, so is the smoothie, on both silhouette paths: the
+/// lines' umbra read 0 for the truth's 1 on 16 px of 128².
+#[test]
+fn a_corner_s_lines_darken_nothing_the_light_s_centre_sees_past_a_thin_caster() {
+    let s = scene(
+        r#"
+[camera]
+position = [1.0, 2.2, 1.6]
+target = [1.6, 0.45, -0.9]
+fov_y_deg = 30.0
+[light]
+position = [3.0, 9.0, 2.5]
+radius = 0.4
+[ground]
+height = 0.0
+[[object]]
+shape = "mesh"
+mesh = "../models/wingnut.obj"
+position = [1.6, 0.45, -0.9]
+rotation_deg = [0.0, 20.0, 0.0]
+scale = 0.3
+"#,
+    );
+    let mut e = engine();
+    let truth = reference(&mut e, &s, 128);
+    let lit = |t: u16| t as f32 >= 0.95 * 65535.0;
+    let in_view = truth.visibility.iter().filter(|&&t| lit(t)).count();
+    assert!(in_view >= 4000, "{in_view} px lit in view");
+    for sets in [CENTRED, &[("penumbra", "1"), ("gpu_silhouettes", "1")]] {
+        let v = render_with(&mut e, &s, "smoothie", sets, 128);
+        let pairs = v.visibility.iter().zip(&truth.visibility);
+        let dark = pairs.filter(|&(&v, &t)| lit(t) && (v as f32) < 0.5 * 65535.0).count();
+        eprintln!("{sets:?}: {dark} of the truth's {in_view} lit px below 0.5");
+        assert_eq!(dark, 0, "{sets:?}: {dark} px the truth sees lit below 0.5");
     }
     finish(e);
 }

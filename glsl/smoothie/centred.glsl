@@ -98,6 +98,22 @@ bool corner_open(float far) {
     return true;
 }
 
+// How far this fragment lies outside the hard shadow the corner's lines stand for (tangent
+// units; below 0 inside): the intersection of their inner sides at a convex turn, the union at a
+// reflex one, a chamfer's line with them (corner_visibility).
+float outside_lines() {
+    vec2 p = fragment_tangent() - in_corner;
+    float one = dot(in_normals.xy, p), other = dot(in_normals.zw, p);
+    bool chamfered = CHAMFER && dot(in_chamfer.xy, in_chamfer.xy) > 0.0;
+    float cut = dot(in_chamfer.xy, p) + in_chamfer.z;
+    if (in_turn > 0.0) {
+        float outside = max(one, other);
+        return chamfered ? max(outside, cut) : outside;
+    }
+    float outside = min(one, other);
+    return chamfered ? min(outside, cut) : outside;
+}
+
 // Near a corner, the alpha whose penumbra parameter gives V under both lines through the
 // resolve's disk-edge curve (falloff.glsl's curve 3, V = disk_below(±α)): an outer α' for a
 // receiver at r, or an inner α, which the resolve remaps by its receiver's own r (exact where
@@ -231,6 +247,20 @@ bool centred_fragment(out Centred c) {
     float r = b + (SAME_GRID ? 0.0 : slack) < caster ? min(caster, ground) : ground;
     c.alpha = remapped_alpha(alpha, r);
     if (CORNERS && corner_open(b + slack)) {
+        // The lines stand for the caster only as far as its outline follows them. Where the map
+        // holds nothing at b, the caster is not there; where the lines still put the whole
+        // footprint in their shadow (their V 0), its outline has left them, past a caster
+        // thinner than the footprint, and their umbra would darken a receiver the light's centre
+        // sees: close to default's wingnut, the lit top of its wing behind a reflex turn of its
+        // outline read 0 for the truth's 1 (a 9 × 9 px patch at 256², 11 px of default at 512²).
+        // Nearer the lines their penumbra stands: there the map's outline may stray from them
+        // by a merged silhouette's tolerance (trusted only to a texel, `merge=2` leaked 18 px
+        // more on the sphere).
+        float texel = max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / min(light.bias.w, light.kernel.x);
+        float footprint = in_size * max(1.0 - b / r, 0.0);
+        if (caster > b + slack && outside_lines() < -max(texel, footprint)) {
+            return false;
+        }
         c.alpha = corner_alpha(c.alpha, r, false, caster <= b + slack);
     }
     if (partial) {
