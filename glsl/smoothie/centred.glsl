@@ -256,9 +256,8 @@ bool centred_fragment(out Centred c) {
         // Nearer the lines their penumbra stands: there the map's outline may stray from them
         // by a merged silhouette's tolerance (trusted only to a texel, `merge=2` leaked 18 px
         // more on the sphere).
-        float texel = max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / min(light.bias.w, light.kernel.x);
         float footprint = in_size * max(1.0 - b / r, 0.0);
-        if (caster > b + slack && outside_lines() < -max(texel, footprint)) {
+        if (caster > b + slack && outside_lines() < -max(coarser_texel(light), footprint)) {
             return false;
         }
         c.alpha = corner_alpha(c.alpha, r, false, caster <= b + slack);

@@ -44,6 +44,12 @@ float probe_step(LightView light) {
     return 1.5 * max(texel.x, texel.y);
 }
 
+// A texel of the coarser of the map and the smoothie buffer, in tangent units (both span the
+// light view's window): how far the two grids may place one edge apart.
+float coarser_texel(LightView light) {
+    return max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / min(light.bias.w, light.kernel.x);
+}
+
 // The depths codes stand for.
 vec4 code_depth(LightView light, vec4 code) {
     return light.depths.x * exp2(code * light.depths.z);

@@ -176,7 +176,7 @@ vec2 centred_test(vec2 uv, float depth, float umbra, MapTexels map, float self_l
     // which counted shadowed the wingnut's wings twice: default's penumbra RMSE 0.057 → 0.061).
     vec4 shadowed = vec4(lessThan(caster, vec4(depth)));
     // Two texels of the coarser grid: a smoothie's depth and the map's a texel from it.
-    float slack = 2.0 * max(light.extent.z - light.extent.x, light.extent.w - light.extent.y) / min(map_size, light.kernel.x);
+    float slack = 2.0 * coarser_texel(light);
     vec4 in_front = t.behind * vec4(lessThan(t.b, depth_code(light, caster * (1.0 - slack))));
     vec4 in_back = t.behind * vec4(greaterThan(t.b, depth_code(light, caster * (1.0 + slack))));
     if (!SAME_GRID) {
