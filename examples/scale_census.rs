@@ -107,12 +107,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let size = SmoothieSize::Physical { light_radius: scene.light.radius, scale: 1.0, behind };
         let frustum =
             frustum.grown(size.largest_reach(frustum.near, frustum.window, ReceiverBound::up_to(frustum.far)));
+        let [x0, y0, x1, y1] = frustum.window;
+        // Slivers a 64th of a buffer texel, as llvmpipe's 8 subpixel bits make them.
+        let sliver = (x1 - x0).max(y1 - y0) / texels as f32 / 64.0;
         let started = Instant::now();
         let (near, far) = depth_range(&frustum.view, &bounds);
-        let penumbra = smoothie::Penumbra::Centred { near, far };
+        let penumbra = smoothie::Penumbra::Centred { near, far, sliver };
         let g = smoothies(&frustum.view, &caster, &closed_edges, (size, ReceiverBound::up_to(frustum.far)), penumbra);
         let smoothie_ms = started.elapsed().as_secs_f64() * 1e3;
-        let [x0, y0, x1, y1] = frustum.window;
         let smoothie_texel = (texels * texels) / f64::from((x1 - x0) * (y1 - y0));
         let xy = |v: &SmoothieVertex| Vec2::new(v.x, v.y);
         let edge_fragments = area(g.edges.iter().map(xy)) * smoothie_texel;

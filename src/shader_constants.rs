@@ -54,8 +54,13 @@ pub const KEEP_ALL: [f32; 2] = [f32::MIN, f32::MAX];
 /// snapping, 1/256 texel.
 pub const CUT_MARGIN: f32 = 0.25;
 
-/// How far a cut quad's sliver over its base reaches from it at its middle, in its width: a
-/// texel or more wherever a piece keeps fragments off the quad's ends.
+/// How far a cut quad's sliver over its base reaches from it (`geometry::smoothie`'s
+/// `edge_quad`), in the rasterizer's subpixel steps (its `subPixelPrecisionBits`), by which the
+/// rounded base of a piece may stray from the hard edge's line: four of them, 1/64 texel on
+/// llvmpipe.
+pub const SLIVER_STEPS: f32 = 4.0;
+
+/// The most a cut quad's sliver reaches from its base, in its width: it stays inside the quad.
 pub const SLIVER: f32 = 0.125;
 
 /// How much of the other's part of the edge each of two pieces keeps at their cut: far more

@@ -71,7 +71,8 @@ struct SilhouetteParams {
                       // bounds the receivers (src/geometry/smoothie.rs's ReceiverBound), else 0
     vec4 corners;     // the hard shadow's corners (src/geometry/smoothie.rs's ShadowCorner): x MIN_TURN,
                       // y CORNER_REACH, z SHARPEST_TURN, w PIECE_MARGIN
-    vec4 pad[7];
+    vec4 sliver;      // x: how far the slivers over cut quads' bases reach (src/geometry/smoothie.rs's Penumbra)
+    vec4 pad[6];
 };
 
 // One caster's shadow volume from one light point, built on the GPU (shadow-volume,

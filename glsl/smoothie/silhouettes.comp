@@ -135,22 +135,18 @@ bool append(Inner inner, Corner c, uint count, out uint at) {
     return at >= kind * params.counts.z && at <= (kind + 1u) * params.counts.z; // from the half's end back
 }
 
-// The quad q0 q1 q2 q3 as two triangles, or its first three vertices alone, keeping `keep` of
-// its edge. Its vertices are written in a loop kept rolled, and its callers call it from as few
-// places as they can: each call is inlined, and llvmpipe's first compile grows with every store
-// inlined (six vertices' stores at each of 26 call sites took it to 50 s, against 4.5 s now).
-void primitive(Vertex q[4], bool triangle, Inner inner, Corner c, vec2 keep) {
-    uint count = triangle ? 3u : 6u, at;
-    if (append(inner, c, count, at)) {
+// The quad q0 q1 q2 q3 as two triangles, keeping `keep` of its edge. Its vertices are written
+// in a loop kept rolled, and its callers call it from as few places as they can: each call is
+// inlined, and llvmpipe's first compile grows with every store inlined (six vertices' stores at
+// each of 26 call sites took it to 50 s, against 4.5 s now).
+void quad(Vertex q[4], Inner inner, Corner c, vec2 keep) {
+    uint at;
+    if (append(inner, c, 6u, at)) {
         const int order[6] = int[6](0, 1, 2, 0, 2, 3);
-        [[dont_unroll]] for (uint k = 0u; k < count; k++) {
+        [[dont_unroll]] for (uint k = 0u; k < 6u; k++) {
             put(at + k, q[order[k]], inner, c, keep);
         }
     }
-}
-
-void quad(Vertex q[4], Inner inner, Corner c, vec2 keep) {
-    primitive(q, false, inner, c, keep);
 }
 
 // a + (b − a)·u, as src/geometry/smoothie.rs's between takes it.
@@ -209,8 +205,12 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
     }
     float width = max(distance(q[0].p, q[3].p), distance(q[1].p, q[2].p));
     float margin = CUT_MARGIN * width / distance(q[0].p, q[1].p);
-    // With each piece, the sliver over the whole hard edge (SLIVER there).
-    Vertex sliver = between(between(q[0], q[1], 0.5), between(q[3], q[2], 0.5), SLIVER);
+    // With each piece, a sliver over the whole hard edge, params.sliver.x wide (at most SLIVER
+    // of the quad's width).
+    float sliver = params.sliver.x;
+    float sb = min(sliver / max(distance(q[1].p, q[2].p), 1e-30), SLIVER);
+    float sa = min(sliver / max(distance(q[0].p, q[3].p), 1e-30), SLIVER);
+    Vertex over_base[4] = Vertex[4](q[0], q[1], between(q[1], q[2], sb), between(q[0], q[3], sa));
     float u[4] = float[4](0.0, cuts.x, 1.0 - cuts.y, 1.0);
     for (int j = 0; j < 3; j++) {
         if (u[j] < u[j + 1]) {
@@ -220,7 +220,7 @@ void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
                                         between(q[3], q[2], g0));
             Corner c = j == 0 ? corners[0] : (j == 2 ? corners[1] : NO_CORNER);
             quad(piece, inner, c, keep);
-            primitive(Vertex[4](q[0], q[1], sliver, sliver), true, inner, c, keep);
+            quad(over_base, inner, c, keep);
         }
     }
 }

@@ -206,6 +206,7 @@ fn run(cli: Cli) -> Result<()> {
             out!("vulkan:   {}", d.vulkan_version);
             out!("max 2D image side:    {}", d.max_image_dimension_2d);
             out!("max push constants:   {} bytes", d.max_push_constants_size);
+            out!("subpixel precision:   {} bits", d.sub_pixel_precision_bits);
             out!("timestamp period:     {} ns, {} valid bits", d.timestamp_period_ns, d.timestamp_valid_bits);
             Ok(())
         }

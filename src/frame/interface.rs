@@ -90,7 +90,9 @@ pub struct SilhouetteParams {
     /// The hard shadow's corners (`geometry::smoothie::ShadowCorner`): x `MIN_TURN`, y its
     /// `CORNER_REACH`, z `SHARPEST_TURN`, w `PIECE_MARGIN`.
     pub corners: Vec4,
-    pub pad: [Vec4; 7],
+    /// x: how far the slivers over cut quads' bases reach (`geometry::smoothie::Penumbra`).
+    pub sliver: Vec4,
+    pub pad: [Vec4; 6],
 }
 
 /// One caster's shadow volume from one light point, built on the GPU, padded to 256 bytes

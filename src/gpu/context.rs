@@ -48,6 +48,8 @@ pub struct DeviceInfo {
     pub max_image_dimension_2d: u32,
     pub max_push_constants_size: u32,
     pub max_storage_buffer_range: u32,
+    /// The rasterizer's subpixel precision: vertices snap to 1/2^bits of a pixel.
+    pub sub_pixel_precision_bits: u32,
     pub timestamp_period_ns: f32,
     pub timestamp_valid_bits: u32,
 }
@@ -336,6 +338,7 @@ impl Context {
             max_image_dimension_2d: limits.max_image_dimension2_d,
             max_push_constants_size: limits.max_push_constants_size,
             max_storage_buffer_range: limits.max_storage_buffer_range,
+            sub_pixel_precision_bits: limits.sub_pixel_precision_bits,
             timestamp_period_ns: limits.timestamp_period,
             timestamp_valid_bits: families[parts.queue_family as usize].timestamp_valid_bits,
         };

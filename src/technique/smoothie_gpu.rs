@@ -107,6 +107,8 @@ struct OutputKey {
     centred: bool,
     /// The light's radius, centred (partial silhouettes); 0 outer only.
     partial_radius: f32,
+    /// How far the slivers over cut quads' bases reach ([`Penumbra::Centred`]).
+    sliver: f32,
     capacity: u64,
 }
 
@@ -137,7 +139,7 @@ impl GpuSilhouettes {
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
         (size, receivers): (SmoothieSize, ReceiverBound),
-        (centred, light_radius): (bool, f32),
+        (centred, light_radius, sliver): (bool, f32, f32),
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<Object> = (frame.scene.objects.iter().zip(cast))
@@ -149,11 +151,11 @@ impl GpuSilhouettes {
             .map(|o| self.meshes.index(ctx, o.mesh.id(), || MeshBuffers::new(ctx, cmd, &o.mesh)))
             .collect::<Result<Vec<_>>>()?;
         // Per edge, outer only, a quad of six vertices; centred, up to three pieces of its quad
-        // (`ShadowCorner::piece`), each with a sliver of three, or a partial silhouette's two quads,
+        // (`ShadowCorner::piece`), each with a sliver of six, or a partial silhouette's two quads,
         // and as many of its inner quad; at most three quads per corner. As many for each kind
         // in its third of the buffer (centred: the inner quads', the partial silhouettes' inner
         // quads').
-        let per_edge = if centred { 3 * (6 + 3) } else { 6 };
+        let per_edge = if centred { 3 * (6 + 6) } else { 6 };
         // That bound is every edge a silhouette with a corner at both ends; a silhouette is a
         // small part of a mesh's edges, and the output is bound as one storage buffer, which may
         // hold no more than maxStorageBufferRange (128 MiB on lavapipe, which the bound of a full
@@ -194,6 +196,7 @@ impl GpuSilhouettes {
             ground,
             centred,
             partial_radius,
+            sliver,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
         // A lost frame ran neither its uploads nor its dispatches.
@@ -204,8 +207,8 @@ impl GpuSilhouettes {
         for (number, o) in (1..).zip(&casters) {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             let model = o.transform.matrix();
-            let (near, caster_far) = match penumbra(centred, &(*view * model), &o.mesh.bounds) {
-                Penumbra::Centred { near, far } => (near, far),
+            let (near, caster_far) = match penumbra(centred, sliver, &(*view * model), &o.mesh.bounds) {
+                Penumbra::Centred { near, far, .. } => (near, far),
                 Penumbra::Outer => (0.0, 0.0),
             };
             params.push(SilhouetteParams {
@@ -215,7 +218,8 @@ impl GpuSilhouettes {
                 light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
                 ground,
                 corners: Vec4::new(MIN_TURN, CORNER_REACH, SHARPEST_TURN, PIECE_MARGIN),
-                pad: [Vec4::ZERO; 7],
+                sliver: Vec4::new(sliver, 0.0, 0.0, 0.0),
+                pad: [Vec4::ZERO; 6],
             });
         }
         let params_buffer = self.params.as_mut().expect("ensured");
