@@ -64,9 +64,9 @@ fn scale(c: &mut Criterion) {
     for (name, mesh) in [("", koala), (", 1-texel shadow mesh", &shadow)] {
         let object = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
         let mut step = 0.0f32;
-        // Slivers a 64th of a texel of a 1024² buffer, as llvmpipe's 8 subpixel bits make them.
+        // The grid of a 1024² buffer, rasterized as llvmpipe does (8 subpixel bits).
         let [x0, y0, x1, y1] = frustum.window;
-        let sliver = (x1 - x0).max(y1 - y0) / 1024.0 / 64.0;
+        let grid = smoothie::CutGrid::new((x1 - x0).max(y1 - y0) / 1024.0, 8);
         // As the technique does: facing from the face planes, only the edges' vertices transformed.
         group.bench_function(format!("plateau CPU geometry, moving frame{name}"), |b| {
             b.iter(|| {
@@ -85,7 +85,7 @@ fn scale(c: &mut Criterion) {
                 let partial = partial_silhouettes(&object, &mesh.planes, &facing, &model, light, 0.3);
                 let view = frustum.view * model;
                 let (near, far) = depth_range(&view, &mesh.bounds);
-                let penumbra = smoothie::Penumbra::Centred { near, far, sliver };
+                let penumbra = smoothie::Penumbra::Centred { near, far, grid };
                 let mut geometry = smoothies(&view, &object, &edges, size, penumbra);
                 geometry.extend(&partial_smoothies(&view, &object, &partial, size, penumbra));
                 geometry

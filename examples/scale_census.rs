@@ -108,11 +108,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let frustum =
             frustum.grown(size.largest_reach(frustum.near, frustum.window, ReceiverBound::up_to(frustum.far)));
         let [x0, y0, x1, y1] = frustum.window;
-        // Slivers a 64th of a buffer texel, as llvmpipe's 8 subpixel bits make them.
-        let sliver = (x1 - x0).max(y1 - y0) / texels as f32 / 64.0;
+        // The buffer's grid, rasterized as llvmpipe does (8 subpixel bits).
+        let grid = smoothie::CutGrid::new((x1 - x0).max(y1 - y0) / texels as f32, 8);
         let started = Instant::now();
         let (near, far) = depth_range(&frustum.view, &bounds);
-        let penumbra = smoothie::Penumbra::Centred { near, far, sliver };
+        let penumbra = smoothie::Penumbra::Centred { near, far, grid };
         let g = smoothies(&frustum.view, &caster, &closed_edges, (size, ReceiverBound::up_to(frustum.far)), penumbra);
         let smoothie_ms = started.elapsed().as_secs_f64() * 1e3;
         let smoothie_texel = (texels * texels) / f64::from((x1 - x0) * (y1 - y0));

@@ -48,12 +48,6 @@ pub const MAX_INNER_REACH: f32 = 64.0;
 /// What a smoothie that is no piece of a cut quad keeps (`SmoothieVertex::keep`): everything.
 pub const KEEP_ALL: [f32; 2] = [f32::MIN, f32::MAX];
 
-/// How far, in smoothie widths (the wider rim), a piece of a cut quad reaches past its cuts
-/// (`geometry::smoothie`'s `edge_quad`): a quarter, at least a texel where the grid resolves the
-/// smoothie (see the technique's `PENUMBRA_TEXELS`), and far more than the rasterizer's
-/// snapping, 1/256 texel.
-pub const CUT_MARGIN: f32 = 0.25;
-
 /// How far a cut quad's sliver over its base reaches from it (`geometry::smoothie`'s
 /// `edge_quad`), in the rasterizer's subpixel steps (its `subPixelPrecisionBits`), by which the
 /// rounded base of a piece may stray from the hard edge's line: four of them, 1/64 texel on

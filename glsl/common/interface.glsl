@@ -71,7 +71,7 @@ struct SilhouetteParams {
                       // bounds the receivers (src/geometry/smoothie.rs's ReceiverBound), else 0
     vec4 corners;     // the hard shadow's corners (src/geometry/smoothie.rs's ShadowCorner): x MIN_TURN,
                       // y CORNER_REACH, z SHARPEST_TURN, w PIECE_MARGIN
-    vec4 sliver;      // x: how far the slivers over cut quads' bases reach (src/geometry/smoothie.rs's Penumbra)
+    vec4 cuts;        // the cut quads' grid (src/geometry/smoothie.rs's CutGrid): x its texel, y its slivers' width
     vec4 pad[6];
 };
 

@@ -196,18 +196,17 @@ vec2 corner_cuts(Vertex outer[4], Vertex inner[4], Corner corners[2]) {
 }
 
 // An edge's quad q (its base from end a to end b, then its rim back) in pieces cut at `cuts`,
-// those within reach of a corner at either end carrying it, each reaching CUT_MARGIN past its
-// cuts and keeping its own part (src/geometry/smoothie.rs's edge_quad).
+// those within reach of a corner at either end carrying it, each keeping its own part and
+// reaching a texel past KEEP_SLACK (src/geometry/smoothie.rs's edge_quad).
 void edge_pieces(Vertex q[4], Inner inner, Corner corners[2], vec2 cuts) {
     if (corners[0].turn == 0.0 && corners[1].turn == 0.0) {
         quad(q, inner, NO_CORNER, KEEP_ALL);
         return;
     }
-    float width = max(distance(q[0].p, q[3].p), distance(q[1].p, q[2].p));
-    float margin = CUT_MARGIN * width / distance(q[0].p, q[1].p);
-    // With each piece, a sliver over the whole hard edge, params.sliver.x wide (at most SLIVER
-    // of the quad's width).
-    float sliver = params.sliver.x;
+    float texel = params.cuts.x, sliver = params.cuts.y;
+    float margin = KEEP_SLACK + texel / distance(q[0].p, q[1].p);
+    // With each piece, a sliver over the whole hard edge, `sliver` wide (at most SLIVER of the
+    // quad's width).
     float sb = min(sliver / max(distance(q[1].p, q[2].p), 1e-30), SLIVER);
     float sa = min(sliver / max(distance(q[0].p, q[3].p), 1e-30), SLIVER);
     Vertex over_base[4] = Vertex[4](q[0], q[1], between(q[1], q[2], sb), between(q[0], q[3], sa));

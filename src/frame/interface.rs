@@ -90,8 +90,8 @@ pub struct SilhouetteParams {
     /// The hard shadow's corners (`geometry::smoothie::ShadowCorner`): x `MIN_TURN`, y its
     /// `CORNER_REACH`, z `SHARPEST_TURN`, w `PIECE_MARGIN`.
     pub corners: Vec4,
-    /// x: how far the slivers over cut quads' bases reach (`geometry::smoothie::Penumbra`).
-    pub sliver: Vec4,
+    /// The cut quads' grid (`geometry::smoothie::CutGrid`): x its texel, y its slivers' width.
+    pub cuts: Vec4,
     pub pad: [Vec4; 6],
 }
 

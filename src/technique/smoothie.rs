@@ -114,7 +114,7 @@ use crate::error::Result;
 use crate::frame::FrameInputs;
 use crate::geometry::silhouette::{Caster, EdgeSource, PartialEdge, partial_silhouettes, penumbra_edges};
 use crate::geometry::smoothie::{
-    Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, depth_range, merged_silhouette, merged_smoothies,
+    CutGrid, Penumbra, ReceiverBound, SmoothieGeometry, SmoothieSize, depth_range, merged_silhouette, merged_smoothies,
     partial_smoothies, smoothies,
 };
 use crate::geometry::{Aabb, LightFrustum, any_two_meet};
@@ -124,7 +124,6 @@ use crate::gpu::{
     ensure, shaders, transition,
 };
 use crate::scene::Mesh;
-use crate::shader_constants::SLIVER_STEPS;
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "smoothie",
@@ -541,7 +540,7 @@ impl Smoothie {
         cast: &[Option<Arc<Mesh>>],
         frustum: &LightFrustum,
         (size, receivers): (SmoothieSize, ReceiverBound),
-        (centred, sliver, tolerance): (bool, f32, f32),
+        (centred, grid, tolerance): (bool, CutGrid, f32),
     ) -> (SmoothieGeometry, Vec<[f32; 4]>) {
         let mut out = SmoothieGeometry::default();
         let mut windows = Vec::new();
@@ -552,7 +551,7 @@ impl Smoothie {
             let caster = Caster { positions: &mesh.positions, triangles: &mesh.triangles, adjacency: &mesh.adjacency };
             let model = o.transform.matrix();
             let view = frustum.view * model;
-            let penumbra = penumbra(centred, sliver, &view, &mesh.bounds);
+            let penumbra = penumbra(centred, grid, &view, &mesh.bounds);
             let mut geometry = if tolerance > 0.0 {
                 let merged = merged_silhouette(&view, &caster, &c.edges, (size, receivers), tolerance);
                 merged_smoothies(&view, &caster, &merged, (size, receivers), penumbra)
@@ -661,7 +660,7 @@ impl Technique for Smoothie {
 
         // The smoothies: vertices drawn directly (CPU path) or indirectly (compute path), and
         // where each caster's lie ([`casters_meet`]).
-        let sliver = sliver(ctx, window / buffer_size as f32);
+        let grid = CutGrid::new(window / buffer_size as f32, ctx.info.sub_pixel_precision_bits);
         let (source, windows) = if gpu_silhouettes {
             if self.gpu.is_none() {
                 self.gpu = Some(GpuSilhouettes::new(ctx)?);
@@ -669,7 +668,7 @@ impl Technique for Smoothie {
             let gpu = self.gpu.as_mut().expect("made above");
             let radius = frame.scene.light.radius;
             let (vertices, args) =
-                gpu.record(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, radius, sliver))?;
+                gpu.record(frame, &cast, &frustum.view, (smoothie_size, receivers), (centred, radius, grid))?;
             let windows = extents.iter().map(|c| c.reach(smoothie_size, receivers)).collect();
             (Smoothies::Indirect { vertices, args }, windows)
         } else {
@@ -677,7 +676,7 @@ impl Technique for Smoothie {
             let [x0, y0, x1, y1] = frustum.window;
             let tolerance = params.get(&MERGE) as f32 * (x1 - x0).max(y1 - y0) / buffer_size as f32;
             let (geometry, windows) =
-                self.geometry(frame, &cast, &frustum, (smoothie_size, receivers), (centred, sliver, tolerance));
+                self.geometry(frame, &cast, &frustum, (smoothie_size, receivers), (centred, grid, tolerance));
             let (vertices, counts) = geometry.drawn();
             let bytes: &[u8] = cast_slice(&vertices);
             let source = if bytes.is_empty() {
@@ -863,21 +862,15 @@ fn narrowest_smoothie(
     casters.map(|(window, deepest)| size.largest_reach(deepest, window, receivers)).fold(f32::INFINITY, f32::min)
 }
 
-/// The smoothies' side for a caster within `bounds` seen through `view`; centred, with slivers
-/// `sliver` wide over cut quads' bases ([`Penumbra::Centred`], [`sliver`]).
-pub(super) fn penumbra(centred: bool, sliver: f32, view: &Mat4, bounds: &Aabb) -> Penumbra {
+/// The smoothies' side for a caster within `bounds` seen through `view`; centred, into the
+/// buffer of `grid`.
+pub(super) fn penumbra(centred: bool, grid: CutGrid, view: &Mat4, bounds: &Aabb) -> Penumbra {
     if centred {
         let (near, far) = depth_range(view, bounds);
-        Penumbra::Centred { near, far, sliver }
+        Penumbra::Centred { near, far, grid }
     } else {
         Penumbra::Outer
     }
-}
-
-/// How far the sliver over a cut quad's base reaches from it ([`Penumbra::Centred`]), in
-/// tangent units: [`SLIVER_STEPS`] of the rasterizer's subpixel steps in a buffer texel of `texel`.
-pub(super) fn sliver(ctx: &Context, texel: f32) -> f32 {
-    texel * SLIVER_STEPS / 2f32.powi(ctx.info.sub_pixel_precision_bits.min(31) as i32)
 }
 
 /// Where this frame's smoothie vertices are.

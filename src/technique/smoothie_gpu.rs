@@ -22,7 +22,9 @@ use crate::frame::FrameInputs;
 use crate::frame::interface::SilhouetteParams;
 use crate::geometry::plateau::MIN_TURN;
 use crate::geometry::silhouette::PARTIAL_GAIN;
-use crate::geometry::smoothie::{CORNER_REACH, PIECE_MARGIN, Penumbra, ReceiverBound, SHARPEST_TURN, SmoothieSize};
+use crate::geometry::smoothie::{
+    CORNER_REACH, CutGrid, PIECE_MARGIN, Penumbra, ReceiverBound, SHARPEST_TURN, SmoothieSize,
+};
 use crate::gpu::{
     Buffer, BufferAccess, Context, DRAW_COMMAND_BYTES, Descriptor, FRAMES_IN_FLIGHT, PerFrame, Pipeline, UploadMark,
     Uploads, Variants, buffer_barrier, dispatch, shaders, update_buffer, upload,
@@ -107,8 +109,8 @@ struct OutputKey {
     centred: bool,
     /// The light's radius, centred (partial silhouettes); 0 outer only.
     partial_radius: f32,
-    /// How far the slivers over cut quads' bases reach ([`Penumbra::Centred`]).
-    sliver: f32,
+    /// The buffer's grid, which the cut quads' pieces reach past their cuts by ([`Penumbra::Centred`]).
+    grid: CutGrid,
     capacity: u64,
 }
 
@@ -139,7 +141,7 @@ impl GpuSilhouettes {
         cast: &[Option<Arc<Mesh>>],
         view: &Mat4,
         (size, receivers): (SmoothieSize, ReceiverBound),
-        (centred, light_radius, sliver): (bool, f32, f32),
+        (centred, light_radius, grid): (bool, f32, CutGrid),
     ) -> Result<(vk::DescriptorBufferInfo, vk::DescriptorBufferInfo)> {
         let ctx = frame.ctx;
         let casters: Vec<Object> = (frame.scene.objects.iter().zip(cast))
@@ -196,7 +198,7 @@ impl GpuSilhouettes {
             ground,
             centred,
             partial_radius,
-            sliver,
+            grid,
             capacity: self.vertices.as_ref().expect("ensured").capacity(),
         };
         // A lost frame ran neither its uploads nor its dispatches.
@@ -207,7 +209,7 @@ impl GpuSilhouettes {
         for (number, o) in (1..).zip(&casters) {
             self.stamp = self.stamp.wrapping_add(1).max(1);
             let model = o.transform.matrix();
-            let (near, caster_far) = match penumbra(centred, sliver, &(*view * model), &o.mesh.bounds) {
+            let (near, caster_far) = match penumbra(centred, grid, &(*view * model), &o.mesh.bounds) {
                 Penumbra::Centred { near, far, .. } => (near, far),
                 Penumbra::Outer => (0.0, 0.0),
             };
@@ -218,7 +220,7 @@ impl GpuSilhouettes {
                 light: Vec4::new(behind, (number % 2) as f32, partial_radius, PARTIAL_GAIN),
                 ground,
                 corners: Vec4::new(MIN_TURN, CORNER_REACH, SHARPEST_TURN, PIECE_MARGIN),
-                sliver: Vec4::new(sliver, 0.0, 0.0, 0.0),
+                cuts: Vec4::new(grid.texel, grid.sliver, 0.0, 0.0),
                 pad: [Vec4::ZERO; 6],
             });
         }
