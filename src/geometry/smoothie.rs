@@ -615,9 +615,9 @@ fn edge_quad(
     // 5.35–5.48 ms against 4.51–4.62 on contact, 2.83–3.06 against 2.42–2.46 on two_boxes and
     // 2.62–2.88 against 2.13–2.32 on overlap (five alternating runs of 20 frames, 512², lavapipe),
     // the suite's images the same on both silhouette paths.
-    let rim = |base: SmoothieVertex, rim: SmoothieVertex| {
-        let reach = point(base).distance(point(rim));
-        between(base, rim, (sliver / reach.max(1e-30)).min(SLIVER))
+    let rim = |base: SmoothieVertex, far: SmoothieVertex| {
+        let reach = point(base).distance(point(far));
+        between(base, far, (sliver / reach.max(1e-30)).min(SLIVER))
     };
     let over_base = [a0, b0, rim(b0, b1), rim(a0, a1)];
     for (u0, u1, corner) in [(0.0, ua, corners[0]), (ua, 1.0 - ub, None), (1.0 - ub, 1.0, corners[1])] {
