@@ -1569,10 +1569,10 @@ mod tests {
         }
     }
 
-    /// The sliver that comes with each piece of a cut quad ([`edge_quad`]): a triangle on the
-    /// uncut quad's own base vertices, so that the hard edge's line, which the map's caster
-    /// shares, is drawn exactly as uncut (the pieces' bases run to rounded cut vertices), and a
-    /// band `sliver` wide over it, which each piece keeps in its own part of the edge.
+    /// The sliver that comes with each piece of a cut quad ([`edge_quad`]): a quad `sliver` wide
+    /// whose first triangle stands on the uncut quad's own base vertices, so that the hard
+    /// edge's line, which the map's caster shares, is drawn exactly as uncut (the pieces' bases
+    /// run to rounded cut vertices), each piece keeping the band in its own part of the edge.
     #[test]
     fn every_piece_of_a_cut_quad_draws_its_exact_base() {
         let at = |x: f32, alpha: f32| weighted(vertex(Vec2::new(x, alpha * 0.2), 0.5, Vec2::X * alpha), 0.2);
